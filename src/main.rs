@@ -1,0 +1,2 @@
+mod petsc;
+fn main() {}

@@ -1,0 +1,87 @@
+use super::error::{check, PetscError};
+use super::ffi;
+use mpi::raw::AsRaw;
+use mpi::topology::SimpleCommunicator;
+use std::ffi::{c_char, c_int, CString};
+
+/// PETSc's lifetime. Create after rsmpi initialised MPI, drop before rsmpi's `Universe`: PETSc then
+/// neither initialises nor finalises MPI itself.
+pub struct Petsc {
+    // PETSc keeps pointers into argv for its whole life.
+    _args: Vec<CString>,
+    _argv: Vec<*mut c_char>,
+}
+
+impl Petsc {
+    /// Collective. `options` are PETSc command-line options (e.g. `-snes_monitor`), passed through
+    /// unchanged so every PETSc option works at run time.
+    pub fn initialize(world: &SimpleCommunicator, options: &[String]) -> Result<Petsc, PetscError> {
+        let mut args = vec![CString::new("pfem-mpi").unwrap_or_default()];
+        for o in options {
+            args.push(CString::new(o.as_str()).map_err(|_| PetscError {
+                code: -1,
+                message: format!("PETSc option {o:?} contains a NUL byte"),
+            })?);
+        }
+        let mut argv: Vec<*mut c_char> = args.iter().map(|a| a.as_ptr() as *mut c_char).collect();
+        argv.push(std::ptr::null_mut());
+        let mut argc = args.len() as c_int;
+        let mut argv_ptr = argv.as_mut_ptr();
+        // SAFETY: MPI is initialised by rsmpi; PETSC_COMM_WORLD must be set before PetscInitialize,
+        // and argv outlives PETSc because `Petsc` owns it.
+        unsafe {
+            ffi::PETSC_COMM_WORLD = world.as_raw();
+            check(
+                ffi::PetscInitialize(&mut argc, &mut argv_ptr, std::ptr::null(), std::ptr::null()),
+                "PetscInitialize",
+            )?;
+            // Errors come back as codes and are reported once by us, not as PETSc tracebacks.
+            check(
+                ffi::PetscPushErrorHandler(Some(ffi::PetscReturnErrorHandler), std::ptr::null_mut()),
+                "PetscPushErrorHandler",
+            )?;
+        }
+        Ok(Petsc {
+            _args: args,
+            _argv: argv,
+        })
+    }
+
+    /// Sets an option unless the user gave it on the command line: our defaults, user's last word.
+    pub fn default_option(&self, name: &str, value: &str) -> Result<(), PetscError> {
+        let cname = cstring(name)?;
+        let cvalue = cstring(value)?;
+        let mut set: ffi::PetscBool = 0;
+        // SAFETY: valid nul-terminated strings; null options database means the global one.
+        unsafe {
+            check(
+                ffi::PetscOptionsHasName(std::ptr::null_mut(), std::ptr::null(), cname.as_ptr(), &mut set),
+                "PetscOptionsHasName",
+            )?;
+            if set == 0 {
+                check(
+                    ffi::PetscOptionsSetValue(std::ptr::null_mut(), cname.as_ptr(), cvalue.as_ptr()),
+                    "PetscOptionsSetValue",
+                )?;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Petsc {
+    fn drop(&mut self) {
+        // SAFETY: every PETSc object is an RAII wrapper borrowed from `Petsc`'s scope, so they are
+        // destroyed before this runs.
+        unsafe {
+            ffi::PetscFinalize();
+        }
+    }
+}
+
+pub(crate) fn cstring(s: &str) -> Result<CString, PetscError> {
+    CString::new(s).map_err(|_| PetscError {
+        code: -1,
+        message: format!("string {s:?} contains a NUL byte"),
+    })
+}

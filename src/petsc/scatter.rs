@@ -1,0 +1,77 @@
+use super::error::{check, PetscError};
+use super::ffi;
+use super::vector::{PVec, VecRef};
+
+/// Gathers chosen global entries of a distributed vector into a sequential local vector: the
+/// owned-plus-ghost values one rank's elements need.
+pub struct Scatter {
+    raw: ffi::VecScatter,
+    local: PVec,
+}
+
+impl Scatter {
+    /// Collective. `global_indices[i]` of `template`'s layout lands in local entry i.
+    pub fn new(template: &PVec, global_indices: &[usize]) -> Result<Scatter, PetscError> {
+        let local = PVec::seq(global_indices.len())?;
+        let from: Vec<ffi::PetscInt> = global_indices.iter().map(|&g| g as ffi::PetscInt).collect();
+        let mut is_from: ffi::IS = std::ptr::null_mut();
+        let mut raw: ffi::VecScatter = std::ptr::null_mut();
+        // SAFETY: the index array is copied by PETSc (PETSC_COPY_VALUES); IS destroyed right after use.
+        unsafe {
+            check(
+                ffi::ISCreateGeneral(
+                    mpi::ffi::RSMPI_COMM_SELF,
+                    from.len() as ffi::PetscInt,
+                    from.as_ptr(),
+                    ffi::PetscCopyMode_PETSC_COPY_VALUES,
+                    &mut is_from,
+                ),
+                "ISCreateGeneral",
+            )?;
+            let made = check(
+                ffi::VecScatterCreate(template.raw, is_from, local.raw, std::ptr::null_mut(), &mut raw),
+                "VecScatterCreate",
+            );
+            ffi::ISDestroy(&mut is_from);
+            made?;
+        }
+        Ok(Scatter { raw, local })
+    }
+
+    /// Collective. Fetches the values and hands them to `f`.
+    pub fn gather<R>(&self, from: VecRef, f: impl FnOnce(&[f64]) -> R) -> Result<R, PetscError> {
+        // SAFETY: both vectors are live and match the layouts the scatter was built for.
+        unsafe {
+            check(
+                ffi::VecScatterBegin(
+                    self.raw,
+                    from.raw,
+                    self.local.raw,
+                    ffi::InsertMode_INSERT_VALUES,
+                    ffi::ScatterMode_SCATTER_FORWARD,
+                ),
+                "VecScatterBegin",
+            )?;
+            check(
+                ffi::VecScatterEnd(
+                    self.raw,
+                    from.raw,
+                    self.local.raw,
+                    ffi::InsertMode_INSERT_VALUES,
+                    ffi::ScatterMode_SCATTER_FORWARD,
+                ),
+                "VecScatterEnd",
+            )?;
+        }
+        self.local.as_ref().read(f)
+    }
+}
+
+impl Drop for Scatter {
+    fn drop(&mut self) {
+        // SAFETY: we own the scatter.
+        unsafe {
+            ffi::VecScatterDestroy(&mut self.raw);
+        }
+    }
+}

@@ -1,0 +1,181 @@
+use super::error::{check, PetscError};
+use super::ffi;
+use super::init::cstring;
+use super::matrix::{Mat, MatRef};
+use super::vector::{PVec, VecRef};
+use mpi::raw::AsRaw;
+use mpi::topology::SimpleCommunicator;
+use std::ffi::{c_void, CStr};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// Why a callback could not evaluate.
+#[derive(Debug, Clone)]
+pub enum CallbackError {
+    /// The trial state is outside the model's domain (e.g. an inverted element): SNES backtracks.
+    Domain(String),
+    /// Anything else: the solve stops with this message.
+    Fatal(String),
+}
+
+/// The physics side of a Newton solve, in the style of PETSc's FormFunction/FormJacobian with a
+/// context: SNES calls back into these with its current iterate.
+pub trait NonlinearProblem {
+    /// Collective. Residual F(x) into the owned entries of `f`.
+    fn residual(&mut self, x: VecRef, f: VecRef) -> Result<(), CallbackError>;
+    /// Collective. Consistent tangent dF/dx at `x` into `j` (assembled on return).
+    fn jacobian(&mut self, x: VecRef, j: MatRef) -> Result<(), CallbackError>;
+}
+
+/// Newton's outcome.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SolveStats {
+    pub newton_iterations: usize,
+    pub linear_iterations: usize,
+    pub residual_norm: f64,
+}
+
+/// A SNES we own; destroyed on drop.
+pub struct Snes {
+    raw: ffi::SNES,
+}
+
+struct Ctx<'a> {
+    problem: &'a mut dyn NonlinearProblem,
+    error: Option<String>,
+}
+
+const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
+
+impl Snes {
+    /// Collective. Newton with line search; direct MUMPS LU by default (robust for the indefinite
+    /// and badly conditioned systems of nearly incompressible soil), every choice overridable by
+    /// PETSc options on the command line.
+    pub fn new(comm: &SimpleCommunicator, rtol: f64, max_it: usize) -> Result<Snes, PetscError> {
+        let mut raw: ffi::SNES = std::ptr::null_mut();
+        // SAFETY: fresh handle; KSP/PC are borrowed from the SNES and not destroyed by us.
+        unsafe {
+            check(ffi::SNESCreate(comm.as_raw(), &mut raw), "SNESCreate")?;
+            let snes = Snes { raw };
+            check(
+                ffi::SNESSetTolerances(raw, 1e-50, rtol, 0.0, max_it as ffi::PetscInt, 10_000),
+                "SNESSetTolerances",
+            )?;
+            let mut ksp: ffi::KSP = std::ptr::null_mut();
+            check(ffi::SNESGetKSP(raw, &mut ksp), "SNESGetKSP")?;
+            let preonly = cstring("preonly")?;
+            check(ffi::KSPSetType(ksp, preonly.as_ptr()), "KSPSetType")?;
+            let mut pc: ffi::PC = std::ptr::null_mut();
+            check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
+            let lu = cstring("lu")?;
+            check(ffi::PCSetType(pc, lu.as_ptr()), "PCSetType")?;
+            let mumps = cstring("mumps")?;
+            check(ffi::PCFactorSetMatSolverType(pc, mumps.as_ptr()), "PCFactorSetMatSolverType")?;
+            check(ffi::SNESSetFromOptions(raw), "SNESSetFromOptions")?;
+            Ok(snes)
+        }
+    }
+
+    /// Collective. Solves F(x) = 0 starting from `x`; `jac` holds the preallocated pattern.
+    pub fn solve(&mut self, problem: &mut dyn NonlinearProblem, x: &PVec, jac: &Mat) -> Result<SolveStats, PetscError> {
+        let r = x.duplicate()?;
+        let mut ctx = Ctx { problem, error: None };
+        let ctx_ptr = &mut ctx as *mut Ctx as *mut c_void;
+        // SAFETY: ctx outlives SNESSolve, the only place the callbacks run; the callbacks catch
+        // panics so none unwinds into C.
+        let solved = unsafe {
+            check(ffi::SNESSetFunction(self.raw, r.raw, Some(residual_cb), ctx_ptr), "SNESSetFunction")?;
+            check(
+                ffi::SNESSetJacobian(self.raw, jac.raw, jac.raw, Some(jacobian_cb), ctx_ptr),
+                "SNESSetJacobian",
+            )?;
+            check(ffi::SNESSolve(self.raw, std::ptr::null_mut(), x.raw), "SNESSolve")
+        };
+        if let Some(msg) = ctx.error.take() {
+            return Err(PetscError { code: PETSC_ERR_USER, message: msg });
+        }
+        solved?;
+        let mut reason: ffi::SNESConvergedReason = 0;
+        let mut its: ffi::PetscInt = 0;
+        let mut lits: ffi::PetscInt = 0;
+        let mut norm = 0.0;
+        // SAFETY: live SNES; the reason string is static in PETSc.
+        unsafe {
+            check(ffi::SNESGetConvergedReason(self.raw, &mut reason), "SNESGetConvergedReason")?;
+            check(ffi::SNESGetIterationNumber(self.raw, &mut its), "SNESGetIterationNumber")?;
+            check(ffi::SNESGetLinearSolveIterations(self.raw, &mut lits), "SNESGetLinearSolveIterations")?;
+            check(ffi::SNESGetFunctionNorm(self.raw, &mut norm), "SNESGetFunctionNorm")?;
+            if reason < 0 {
+                let mut text: *const std::os::raw::c_char = std::ptr::null();
+                check(ffi::SNESGetConvergedReasonString(self.raw, &mut text), "SNESGetConvergedReasonString")?;
+                let why = if text.is_null() {
+                    format!("reason {reason}")
+                } else {
+                    CStr::from_ptr(text).to_string_lossy().into_owned()
+                };
+                return Err(PetscError {
+                    code: PETSC_ERR_USER,
+                    message: format!("Newton did not converge ({why}) after {its} iterations, residual {norm:.3e}"),
+                });
+            }
+        }
+        Ok(SolveStats {
+            newton_iterations: its as usize,
+            linear_iterations: lits as usize,
+            residual_norm: norm,
+        })
+    }
+}
+
+impl Drop for Snes {
+    fn drop(&mut self) {
+        // SAFETY: we own the SNES.
+        unsafe {
+            ffi::SNESDestroy(&mut self.raw);
+        }
+    }
+}
+
+fn report(snes: ffi::SNES, ctx: &mut Ctx, outcome: std::thread::Result<Result<(), CallbackError>>) -> ffi::PetscErrorCode {
+    match outcome {
+        Ok(Ok(())) => 0,
+        Ok(Err(CallbackError::Domain(msg))) => {
+            ctx_note(ctx, None, &msg);
+            // SAFETY: live SNES inside its own callback.
+            unsafe { ffi::SNESSetFunctionDomainError(snes) }
+        }
+        Ok(Err(CallbackError::Fatal(msg))) => {
+            ctx_note(ctx, Some(()), &msg);
+            PETSC_ERR_USER
+        }
+        Err(_) => {
+            ctx_note(ctx, Some(()), "internal error: a panic in the residual or Jacobian");
+            PETSC_ERR_USER
+        }
+    }
+}
+
+fn ctx_note(ctx: &mut Ctx, fatal: Option<()>, msg: &str) {
+    if fatal.is_some() && ctx.error.is_none() {
+        ctx.error = Some(msg.to_string());
+    }
+}
+
+unsafe extern "C" fn residual_cb(snes: ffi::SNES, x: ffi::Vec, f: ffi::Vec, ctx: *mut c_void) -> ffi::PetscErrorCode {
+    // SAFETY: ctx is the `Ctx` that `Snes::solve` keeps alive during SNESSolve.
+    let ctx = unsafe { &mut *(ctx as *mut Ctx) };
+    let outcome = catch_unwind(AssertUnwindSafe(|| ctx.problem.residual(VecRef { raw: x }, VecRef { raw: f })));
+    report(snes, ctx, outcome)
+}
+
+unsafe extern "C" fn jacobian_cb(
+    snes: ffi::SNES,
+    x: ffi::Vec,
+    j: ffi::Mat,
+    _p: ffi::Mat,
+    ctx: *mut c_void,
+) -> ffi::PetscErrorCode {
+    // SAFETY: as in `residual_cb`.
+    let ctx = unsafe { &mut *(ctx as *mut Ctx) };
+    let outcome = catch_unwind(AssertUnwindSafe(|| ctx.problem.jacobian(VecRef { raw: x }, MatRef { raw: j })));
+    report(snes, ctx, outcome)
+}

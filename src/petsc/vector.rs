@@ -1,0 +1,111 @@
+use super::error::{check, PetscError};
+use super::ffi;
+use mpi::raw::AsRaw;
+use mpi::topology::SimpleCommunicator;
+
+/// A PETSc vector we own; destroyed on drop.
+pub struct PVec {
+    pub(crate) raw: ffi::Vec,
+}
+
+/// A PETSc vector lent to us by PETSc (inside a callback); never destroyed by us.
+#[derive(Clone, Copy)]
+pub struct VecRef {
+    pub(crate) raw: ffi::Vec,
+}
+
+impl PVec {
+    /// Collective. Distributed vector with `n_local` entries on this rank.
+    pub fn mpi(comm: &SimpleCommunicator, n_local: usize) -> Result<PVec, PetscError> {
+        let mut raw: ffi::Vec = std::ptr::null_mut();
+        // SAFETY: out-pointer to a fresh handle.
+        check(
+            unsafe {
+                ffi::VecCreateMPI(comm.as_raw(), n_local as ffi::PetscInt, ffi::PETSC_DETERMINE as ffi::PetscInt, &mut raw)
+            },
+            "VecCreateMPI",
+        )?;
+        Ok(PVec { raw })
+    }
+
+    /// Sequential vector of length `n` on this rank alone.
+    pub fn seq(n: usize) -> Result<PVec, PetscError> {
+        let mut raw: ffi::Vec = std::ptr::null_mut();
+        // SAFETY: out-pointer to a fresh handle; PETSC_COMM_SELF is MPI_COMM_SELF.
+        check(
+            unsafe { ffi::VecCreateSeq(mpi::ffi::RSMPI_COMM_SELF, n as ffi::PetscInt, &mut raw) },
+            "VecCreateSeq",
+        )?;
+        Ok(PVec { raw })
+    }
+
+    /// Collective. Same layout, uninitialised values.
+    pub fn duplicate(&self) -> Result<PVec, PetscError> {
+        let mut raw: ffi::Vec = std::ptr::null_mut();
+        // SAFETY: self.raw is a live vector.
+        check(unsafe { ffi::VecDuplicate(self.raw, &mut raw) }, "VecDuplicate")?;
+        Ok(PVec { raw })
+    }
+
+    pub fn as_ref(&self) -> VecRef {
+        VecRef { raw: self.raw }
+    }
+}
+
+impl Drop for PVec {
+    fn drop(&mut self) {
+        // SAFETY: we own the handle; VecDestroy nulls it.
+        unsafe {
+            ffi::VecDestroy(&mut self.raw);
+        }
+    }
+}
+
+impl VecRef {
+    /// The locally owned entries, read-only.
+    pub fn read<R>(&self, f: impl FnOnce(&[f64]) -> R) -> Result<R, PetscError> {
+        let n = self.local_size()?;
+        let mut ptr: *const f64 = std::ptr::null();
+        // SAFETY: PETSc hands out the local array until the matching restore call.
+        check(unsafe { ffi::VecGetArrayRead(self.raw, &mut ptr) }, "VecGetArrayRead")?;
+        let slice = if n == 0 { &[][..] } else { unsafe { std::slice::from_raw_parts(ptr, n) } };
+        let out = f(slice);
+        check(unsafe { ffi::VecRestoreArrayRead(self.raw, &mut ptr) }, "VecRestoreArrayRead")?;
+        Ok(out)
+    }
+
+    /// The locally owned entries, writable.
+    pub fn write<R>(&self, f: impl FnOnce(&mut [f64]) -> R) -> Result<R, PetscError> {
+        let n = self.local_size()?;
+        let mut ptr: *mut f64 = std::ptr::null_mut();
+        // SAFETY: as in `read`; no other borrow of this array exists while `f` runs.
+        check(unsafe { ffi::VecGetArray(self.raw, &mut ptr) }, "VecGetArray")?;
+        let slice = if n == 0 { &mut [][..] } else { unsafe { std::slice::from_raw_parts_mut(ptr, n) } };
+        let out = f(slice);
+        check(unsafe { ffi::VecRestoreArray(self.raw, &mut ptr) }, "VecRestoreArray")?;
+        Ok(out)
+    }
+
+    pub fn local_size(&self) -> Result<usize, PetscError> {
+        let mut n: ffi::PetscInt = 0;
+        // SAFETY: live vector.
+        check(unsafe { ffi::VecGetLocalSize(self.raw, &mut n) }, "VecGetLocalSize")?;
+        Ok(n as usize)
+    }
+
+    /// First global index owned by this rank.
+    pub fn ownership_start(&self) -> Result<usize, PetscError> {
+        let (mut lo, mut hi): (ffi::PetscInt, ffi::PetscInt) = (0, 0);
+        // SAFETY: live vector.
+        check(unsafe { ffi::VecGetOwnershipRange(self.raw, &mut lo, &mut hi) }, "VecGetOwnershipRange")?;
+        Ok(lo as usize)
+    }
+
+    /// Collective. Euclidean norm over all ranks.
+    pub fn norm2(&self) -> Result<f64, PetscError> {
+        let mut v = 0.0;
+        // SAFETY: live vector.
+        check(unsafe { ffi::VecNorm(self.raw, ffi::NormType_NORM_2, &mut v) }, "VecNorm")?;
+        Ok(v)
+    }
+}

@@ -1,0 +1,1 @@
+#include <petscsnes.h>
