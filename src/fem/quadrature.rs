@@ -128,7 +128,9 @@ mod tests {
         // Degree is sharp: some monomial of degree+1 is missed, so the test above can fail.
         let d1 = deg + 1;
         let worst = (0..=d1)
-            .map(|p| (rule_monomial(rule, p as i32, (d1 - p) as i32) - exact_monomial(p, d1 - p)).abs())
+            .map(|p| {
+                (rule_monomial(rule, p as i32, (d1 - p) as i32) - exact_monomial(p, d1 - p)).abs()
+            })
             .fold(0.0_f64, f64::max);
         assert!(worst > 1e-6, "rule unexpectedly exact at degree {d1}");
     }

@@ -39,8 +39,11 @@ pub fn barycentric(a: [f64; 2], b: [f64; 2], c: [f64; 2], p: [f64; 2]) -> [f64; 
     [1.0 - lb - lc, lb, lc]
 }
 
-/// Σ_k bary[k] · vertex_values[k], component by component.
-pub fn interpolate_linear<const K: usize>(bary: [f64; 3], vertex_values: &[[f64; K]; 3]) -> [f64; K] {
+/// `Σ_k bary[k] · vertex_values[k]`, component by component.
+pub fn interpolate_linear<const K: usize>(
+    bary: [f64; 3],
+    vertex_values: &[[f64; K]; 3],
+) -> [f64; K] {
     let mut out = [0.0; K];
     for (l, v) in bary.iter().zip(vertex_values.iter()) {
         for (o, vk) in out.iter_mut().zip(v.iter()) {
@@ -51,6 +54,8 @@ pub fn interpolate_linear<const K: usize>(bary: [f64; 3], vertex_values: &[[f64;
 }
 
 #[cfg(test)]
+// Index loops mirror the component notation of the formulas being checked.
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
     use crate::fem::element::p2_gauss_points;
@@ -70,7 +75,9 @@ mod tests {
     fn gauss_to_vertex_inverts_the_rule() {
         for i in 0..3 {
             for j in 0..3 {
-                let s: f64 = (0..3).map(|q| GAUSS_TO_VERTEX[i][q] * TRI3_POINTS[q][j]).sum();
+                let s: f64 = (0..3)
+                    .map(|q| GAUSS_TO_VERTEX[i][q] * TRI3_POINTS[q][j])
+                    .sum();
                 let want = if i == j { 1.0 } else { 0.0 };
                 assert!((s - want).abs() < 1e-15, "({i},{j}) = {s}");
             }
@@ -88,7 +95,10 @@ mod tests {
             let want = field(v[k]);
             for c in 0..4 {
                 let tol = 1e-12 * want[c].abs().max(1.0);
-                assert!((at_vertices[k][c] - want[c]).abs() < tol, "vertex {k} comp {c}");
+                assert!(
+                    (at_vertices[k][c] - want[c]).abs() < tol,
+                    "vertex {k} comp {c}"
+                );
             }
         }
         // Not the identity: a plain copy of the Gauss values would fail the check above.
@@ -125,7 +135,10 @@ mod tests {
             let got = interpolate_linear(barycentric(a, b, c, p), &vals);
             let want = field(p);
             for k in 0..4 {
-                assert!((got[k] - want[k]).abs() < 1e-12 * want[k].abs().max(1.0), "{p:?} {k}");
+                assert!(
+                    (got[k] - want[k]).abs() < 1e-12 * want[k].abs().max(1.0),
+                    "{p:?} {k}"
+                );
             }
         }
     }

@@ -63,14 +63,22 @@ impl LinearElastic {
 }
 
 impl Material for LinearElastic {
-    fn update(&self, state_n: &GaussState, e: &[f64; 4]) -> Result<MaterialResponse, MaterialError> {
+    fn update(
+        &self,
+        state_n: &GaussState,
+        e: &[f64; 4],
+    ) -> Result<MaterialResponse, MaterialError> {
         if e.iter().any(|v| !v.is_finite()) {
             return Err(MaterialError::NonFiniteStrain { strain: *e });
         }
         let d = self.stiffness();
         let mut s = state_n.stress;
         for (si, row) in s.iter_mut().zip(d.iter()) {
-            *si += row.iter().zip(e.iter()).map(|(dij, ej)| dij * ej).sum::<f64>();
+            *si += row
+                .iter()
+                .zip(e.iter())
+                .map(|(dij, ej)| dij * ej)
+                .sum::<f64>();
         }
         Ok(MaterialResponse {
             s,
@@ -85,6 +93,8 @@ impl Material for LinearElastic {
 }
 
 #[cfg(test)]
+// Index loops mirror the component notation of the formulas being checked.
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
 
@@ -143,7 +153,12 @@ mod tests {
             st.stress[3] + mu * e[3],
         ];
         for k in 0..4 {
-            assert!(close(r.s[k], want[k], 1e-13), "S[{k}] {} vs {}", r.s[k], want[k]);
+            assert!(
+                close(r.s[k], want[k], 1e-13),
+                "S[{k}] {} vs {}",
+                r.s[k],
+                want[k]
+            );
         }
         assert_eq!(r.state.plastic_strain, [0.0; 4]);
         assert_eq!(r.state.eps_q, 0.0);

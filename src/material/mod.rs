@@ -124,7 +124,8 @@ pub trait Material: Send + Sync + fmt::Debug {
     /// `e` is the Green–Lagrange strain of the step relative to x_n (Voigt, engineering shear,
     /// `e[2] = 0` in plane strain). Must not mutate anything: Newton iterations call it repeatedly
     /// from the same `state_n`.
-    fn update(&self, state_n: &GaussState, e: &[f64; 4]) -> Result<MaterialResponse, MaterialError>;
+    fn update(&self, state_n: &GaussState, e: &[f64; 4])
+        -> Result<MaterialResponse, MaterialError>;
 
     /// Short identifier used in logs and input files.
     fn name(&self) -> &'static str;

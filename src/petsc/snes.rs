@@ -70,6 +70,12 @@ impl Snes {
             check(ffi::PCSetType(pc, lu.as_ptr()), "PCSetType")?;
             let mumps = cstring("mumps")?;
             check(ffi::PCFactorSetMatSolverType(pc, mumps.as_ptr()), "PCFactorSetMatSolverType")?;
+            // Full Newton steps: the large-rotation residual grows on the first iterate of a load
+            // step before Newton's quadratic phase, and a backtracking search then crawls.
+            let mut ls: ffi::SNESLineSearch = std::ptr::null_mut();
+            check(ffi::SNESGetLineSearch(raw, &mut ls), "SNESGetLineSearch")?;
+            let basic = cstring("basic")?;
+            check(ffi::SNESLineSearchSetType(ls, basic.as_ptr()), "SNESLineSearchSetType")?;
             check(ffi::SNESSetFromOptions(raw), "SNESSetFromOptions")?;
             Ok(snes)
         }

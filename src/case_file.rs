@@ -1,0 +1,374 @@
+//! Case files: the complete state of an analysis (scene, progress, particles) in one HDF5 file,
+//! used both to start a case and as a checkpoint to restart from.
+//!
+//! Format version 1. Root attributes:
+//!
+//! | name | type | meaning |
+//! |---|---|---|
+//! | `format` | string | always `"pfem-mpi case"` |
+//! | `format_version` | u32 | 1 |
+//! | `code_version` | string | version of the pfem-mpi that wrote the file |
+//! | `scene` | string | the full resolved scene as TOML (overrides and defaults applied) |
+//! | `scene_source` | string | scene file name or built-in name |
+//! | `step` | u64 | completed load steps |
+//! | `load_factor` | f64 | load factor reached |
+//! | `time` | f64 | analysis time reached |
+//! | `next_gid` | u64 | first global id not yet used |
+//! | `ranks` | u32 | number of MPI ranks that wrote the file |
+//! | `tracked_gids` | u64 array | particle tracked by each `[[point_load]]`, in order |
+//!
+//! Datasets in group `/particles`, n = global particle count, one row per particle:
+//! `gid` (u64, n), `position` (f64, n x 2, current), `displacement` (f64, n x 2, total since the
+//! start), `h` (f64, n), `state` (f64, n x 9), `flags` (u32, n).
+//!
+//! The file is written collectively by all ranks (each writes its own rows, placed by rank
+//! order) and can be read back by any number of ranks, each getting a contiguous block.
+
+#[path = "case_file/collective.rs"]
+mod collective;
+#[path = "case_file/datasets.rs"]
+mod datasets;
+#[path = "case_file/error.rs"]
+mod error;
+#[path = "case_file/ffi.rs"]
+mod ffi;
+#[path = "case_file/header.rs"]
+mod header;
+#[path = "case_file/particles.rs"]
+mod particles;
+#[path = "case_file/summary.rs"]
+mod summary;
+
+use std::io::{Read, Seek, SeekFrom};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use hdf5::{Dataset, File, Group, H5Type};
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::*;
+
+pub use collective::block_range;
+pub use error::{CaseError, CaseErrorKind};
+pub use particles::{ParticleSet, STATE_LEN};
+
+use crate::scene::{generate_particles, lattice, Scene};
+use collective::agree;
+use datasets::Column;
+
+/// Value of the `format` attribute.
+pub const FORMAT: &str = "pfem-mpi case";
+/// Format version written by this program, and the newest it reads.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Everything in a case file except the particles.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CaseHeader {
+    /// Format version of the file read; [`write_case`] always writes [`FORMAT_VERSION`].
+    pub format_version: u32,
+    /// Version of the pfem-mpi that wrote (or will write) the file.
+    pub code_version: String,
+    /// The resolved scene as TOML; [`Scene::from_toml`] reads it back.
+    pub scene_toml: String,
+    /// Scene file name or built-in name the case was created from.
+    pub scene_source: String,
+    pub step: u64,
+    pub load_factor: f64,
+    pub time: f64,
+    /// First global particle id not yet used.
+    pub next_gid: u64,
+    /// Rank count that wrote the file; [`write_case`] records the writing communicator's size.
+    pub ranks: u32,
+    /// Global id of the particle tracked by each `[[point_load]]`, in scene order.
+    pub tracked_gids: Vec<u64>,
+}
+
+/// A new case at step 0: the scene's particle lattice and, for each point load, the particle
+/// nearest to its `at` point (ties go to the smaller gid).
+pub fn new_case(scene: &Scene, source: &str) -> (CaseHeader, ParticleSet) {
+    let particles = generate_particles(scene);
+    let tracked_gids = scene
+        .point_load
+        .iter()
+        .filter_map(|p| lattice::nearest(&particles, p.at).map(|(gid, _)| gid))
+        .collect();
+    let header = CaseHeader {
+        format_version: FORMAT_VERSION,
+        code_version: env!("CARGO_PKG_VERSION").to_string(),
+        scene_toml: scene.to_toml(),
+        scene_source: source.to_string(),
+        step: 0,
+        load_factor: 0.0,
+        time: 0.0,
+        next_gid: particles.len() as u64,
+        ranks: 1,
+        tracked_gids,
+    };
+    (header, particles)
+}
+
+const HDF5_SIGNATURE: [u8; 8] = [0x89, b'H', b'D', b'F', b'\r', b'\n', 0x1a, b'\n'];
+
+/// Checks that `path` is a readable HDF5 file before handing it to the library. The signature
+/// is at offset 0 or, after a user block, at 512, 1024, 2048, ...
+fn sniff(path: &Path) -> Result<(), CaseError> {
+    let io = |e: std::io::Error| CaseError::new(path, CaseErrorKind::Io, format!("cannot read: {e}"));
+    let mut f = std::fs::File::open(path).map_err(io)?;
+    let len = f.metadata().map_err(io)?.len();
+    let mut offset = 0u64;
+    while offset + 8 <= len {
+        let mut sig = [0u8; 8];
+        f.seek(SeekFrom::Start(offset)).map_err(io)?;
+        f.read_exact(&mut sig).map_err(io)?;
+        if sig == HDF5_SIGNATURE {
+            return Ok(());
+        }
+        offset = if offset == 0 { 512 } else { offset * 2 };
+    }
+    Err(CaseError::new(path, CaseErrorKind::NotHdf5, "not an HDF5 file"))
+}
+
+fn open_error(path: &Path, e: hdf5::Error) -> CaseError {
+    let text = e.to_string();
+    if text.contains("truncated") {
+        CaseError::new(path, CaseErrorKind::Malformed, format!("truncated file ({text})"))
+    } else {
+        CaseError::new(path, CaseErrorKind::Io, format!("cannot open: {text}"))
+    }
+}
+
+fn tmp_path(path: &Path) -> PathBuf {
+    let mut name = path.as_os_str().to_owned();
+    name.push(".tmp");
+    PathBuf::from(name)
+}
+
+fn mpio_file(comm: &SimpleCommunicator, path: &Path, create: bool) -> hdf5::Result<File> {
+    let mut builder = File::with_options();
+    builder.with_fapl(|p| p.mpio(comm.as_raw(), None));
+    if create {
+        builder.create(path)
+    } else {
+        builder.open(path)
+    }
+}
+
+/// Writes this rank's rows `rows` of column `c` (collective).
+fn write_column<T: H5Type>(
+    group: &Group,
+    c: &Column,
+    n: usize,
+    rows: Range<usize>,
+    data: &[T],
+) -> hdf5::Result<()> {
+    let ds = datasets::create::<T>(group, c, n)?;
+    let space = ds.space()?;
+    let selected = if c.width == 0 {
+        space.select(rows)?
+    } else {
+        space.select((rows, ..))?
+    };
+    ffi::write_collective(&ds, &selected, data)
+}
+
+/// Reads rows `rows` of `ds` into `out` (collective).
+fn read_column<T: H5Type>(ds: &Dataset, width: usize, rows: Range<usize>, out: &mut [T]) -> hdf5::Result<()> {
+    let space = ds.space()?;
+    let selected = if width == 0 {
+        space.select(rows)?
+    } else {
+        space.select((rows, ..))?
+    };
+    ffi::read_collective(ds, &selected, out)
+}
+
+fn write_contents(
+    file: &File,
+    header: &CaseHeader,
+    ranks: u32,
+    local: &ParticleSet,
+    rows: Range<usize>,
+    n: usize,
+) -> hdf5::Result<()> {
+    header::write_header(file, header, ranks)?;
+    let group = file.create_group(datasets::GROUP)?;
+    let [gid, position, displacement, h, state, flags] = datasets::columns();
+    write_column(&group, &gid, n, rows.clone(), &local.gid)?;
+    write_column(&group, &position, n, rows.clone(), local.position.as_flattened())?;
+    write_column(&group, &displacement, n, rows.clone(), local.displacement.as_flattened())?;
+    write_column(&group, &h, n, rows.clone(), &local.h)?;
+    write_column(&group, &state, n, rows.clone(), local.state.as_flattened())?;
+    write_column(&group, &flags, n, rows, &local.flags)
+}
+
+/// Collective. Writes a case file: every rank passes its own particles (any count, zero
+/// included), which are stored in rank order. The file is written as `path.tmp` and renamed to
+/// `path` by rank 0 once every rank has closed it, so an interrupted write never leaves a
+/// partial file under the final name. On error every rank returns the same error.
+pub fn write_case(
+    comm: &SimpleCommunicator,
+    path: &Path,
+    header: &CaseHeader,
+    local: &ParticleSet,
+) -> Result<(), CaseError> {
+    let checked = local
+        .check_lengths()
+        .map_err(|m| CaseError::new(path, CaseErrorKind::InvalidInput, m));
+    agree(comm, path, checked)?;
+
+    let count = local.len() as u64;
+    let mut inclusive = 0u64;
+    comm.scan_into(&count, &mut inclusive, mpi::collective::SystemOperation::sum());
+    let mut total = 0u64;
+    comm.all_reduce_into(&count, &mut total, mpi::collective::SystemOperation::sum());
+    let start = (inclusive - count) as usize;
+    let rows = start..start + local.len();
+
+    let tmp = tmp_path(path);
+    let created = mpio_file(comm, &tmp, true).map_err(|e| {
+        CaseError::new(path, CaseErrorKind::Io, format!("cannot create {}: {e}", tmp.display()))
+    });
+    let file = agree(comm, path, created)?;
+    let ranks = comm.size() as u32;
+    let written = write_contents(&file, header, ranks, local, rows, total as usize);
+    let closed = file.close();
+    let outcome = written.and(closed).map_err(|e| {
+        CaseError::new(path, CaseErrorKind::Io, format!("cannot write {}: {e}", tmp.display()))
+    });
+    if let Err(e) = agree(comm, path, outcome) {
+        if comm.rank() == 0 {
+            // Best effort: the write already failed, a leftover temporary is harmless.
+            let _ = std::fs::remove_file(&tmp);
+        }
+        return Err(e);
+    }
+
+    let renamed = if comm.rank() == 0 {
+        std::fs::rename(&tmp, path).map_err(|e| {
+            CaseError::new(path, CaseErrorKind::Io, format!("cannot rename {} to it: {e}", tmp.display()))
+        })
+    } else {
+        Ok(())
+    };
+    agree(comm, path, renamed)
+}
+
+fn read_contents(
+    comm: &SimpleCommunicator,
+    file: &File,
+    path: &Path,
+) -> Result<(CaseHeader, ParticleSet), CaseError> {
+    let header = agree(comm, path, header::read_header(file, path))?;
+    let (ds, n) = agree(comm, path, datasets::open_all(file, path))?;
+    let block = block_range(n, comm.size() as u64, comm.rank() as u64);
+    let rows = block.start as usize..block.end as usize;
+    let count = rows.len();
+    let mut p = ParticleSet {
+        gid: vec![0; count],
+        position: vec![[0.0; 2]; count],
+        displacement: vec![[0.0; 2]; count],
+        h: vec![0.0; count],
+        state: vec![[0.0; STATE_LEN]; count],
+        flags: vec![0; count],
+    };
+    let [gid, position, displacement, h, state, flags] = datasets::columns();
+    let read = (|| {
+        read_column(&ds[0], gid.width, rows.clone(), &mut p.gid)?;
+        read_column(&ds[1], position.width, rows.clone(), p.position.as_flattened_mut())?;
+        read_column(&ds[2], displacement.width, rows.clone(), p.displacement.as_flattened_mut())?;
+        read_column(&ds[3], h.width, rows.clone(), &mut p.h)?;
+        read_column(&ds[4], state.width, rows.clone(), p.state.as_flattened_mut())?;
+        read_column(&ds[5], flags.width, rows, &mut p.flags)
+    })()
+    .map_err(|e| CaseError::new(path, CaseErrorKind::Malformed, format!("cannot read particles: {e}")));
+    agree(comm, path, read)?;
+    Ok((header, p))
+}
+
+/// Collective. Reads the header on every rank and a contiguous block of the particles on each
+/// (`block_range(n, size, rank)`); the file may have been written by any number of ranks. On
+/// error every rank returns the same error; a damaged or foreign file is an error, never a
+/// panic.
+pub fn read_case(
+    comm: &SimpleCommunicator,
+    path: &Path,
+) -> Result<(CaseHeader, ParticleSet), CaseError> {
+    agree(comm, path, sniff(path))?;
+    let opened = mpio_file(comm, path, false).map_err(|e| open_error(path, e));
+    let file = agree(comm, path, opened)?;
+    let contents = read_contents(comm, &file, path);
+    let closed = file
+        .close()
+        .map_err(|e| CaseError::new(path, CaseErrorKind::Io, format!("cannot close: {e}")));
+    let outcome = contents.and_then(|c| closed.map(|_| c));
+    agree(comm, path, outcome)
+}
+
+/// Human-readable summary of a case file (format, scene, progress, particles, extent), for
+/// `pfem-mpi info`. Reads the file serially; needs no communicator.
+pub fn summarize(path: &Path) -> Result<String, CaseError> {
+    sniff(path)?;
+    let file = File::open(path).map_err(|e| open_error(path, e))?;
+    let header = header::read_header(&file, path)?;
+    let (ds, n) = datasets::open_all(&file, path)?;
+    let read_err = |name: &str, e: hdf5::Error| {
+        CaseError::new(path, CaseErrorKind::Malformed, format!("cannot read: {e}"))
+            .at(format!("dataset /{}/{name}", datasets::GROUP))
+    };
+    let gid = ds[0].read_raw::<u64>().map_err(|e| read_err("gid", e))?;
+    let pairs = |d: &Dataset, name: &str| -> Result<Vec<[f64; 2]>, CaseError> {
+        let flat = d.read_raw::<f64>().map_err(|e| read_err(name, e))?;
+        Ok(flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+    };
+    let position = pairs(&ds[1], "position")?;
+    let displacement = pairs(&ds[2], "displacement")?;
+    Ok(summary::render(
+        path,
+        &header,
+        n,
+        &gid,
+        &position,
+        &displacement,
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::load_scene;
+
+    #[test]
+    fn cantilever_tracks_the_particle_at_the_loaded_tip() {
+        let (scene, resolved) = load_scene("cantilever", &[]).unwrap();
+        let (header, particles) = new_case(&scene, "cantilever");
+        assert_eq!(header.tracked_gids.len(), 1);
+        let gid = header.tracked_gids[0];
+        let i = particles.gid.iter().position(|&g| g == gid).unwrap();
+        assert_eq!(particles.position[i], [10.0, 0.5]);
+        assert_eq!(gid, 4 * 81 + 80);
+        assert_eq!(header.next_gid, 729);
+        assert_eq!(header.scene_toml, resolved);
+        assert_eq!(header.step, 0);
+    }
+
+    #[test]
+    fn sniff_rejects_non_hdf5_and_missing_files() {
+        let dir = std::env::temp_dir().join(format!("pfem-case-sniff-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let text = dir.join("notes.h5");
+        std::fs::write(&text, b"just some text, long enough to be read").unwrap();
+        let e = sniff(&text).unwrap_err();
+        assert_eq!(e.kind, CaseErrorKind::NotHdf5);
+        assert_eq!(e.to_string(), format!("{}: not an HDF5 file", text.display()));
+        let e = summarize(&text).unwrap_err();
+        assert_eq!(e.kind, CaseErrorKind::NotHdf5);
+        let e = summarize(&dir.join("absent.h5")).unwrap_err();
+        assert_eq!(e.kind, CaseErrorKind::Io);
+        assert!(e.to_string().contains("absent.h5: cannot read"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn tmp_path_appends_suffix() {
+        assert_eq!(tmp_path(Path::new("out/case.h5")), PathBuf::from("out/case.h5.tmp"));
+    }
+}

@@ -1,0 +1,103 @@
+//! Particles as parallel arrays, the unit that case files store and ranks exchange.
+
+/// Number of per-particle state values (`ParticleSet::state`).
+pub const STATE_LEN: usize = 9;
+
+/// A set of particles, one entry per particle in each array (all arrays have the same length).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ParticleSet {
+    /// Global particle id, unique over all ranks.
+    pub gid: Vec<u64>,
+    /// Current position (m).
+    pub position: Vec<[f64; 2]>,
+    /// Total displacement since the start of the analysis (m).
+    pub displacement: Vec<[f64; 2]>,
+    /// Local particle spacing (m).
+    pub h: Vec<f64>,
+    /// Per-particle material state (stresses, plastic variables), meaning set by the material.
+    pub state: Vec<[f64; STATE_LEN]>,
+    /// Per-particle bit flags.
+    pub flags: Vec<u32>,
+}
+
+impl ParticleSet {
+    pub fn with_capacity(n: usize) -> Self {
+        ParticleSet {
+            gid: Vec::with_capacity(n),
+            position: Vec::with_capacity(n),
+            displacement: Vec::with_capacity(n),
+            h: Vec::with_capacity(n),
+            state: Vec::with_capacity(n),
+            flags: Vec::with_capacity(n),
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.gid.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.gid.is_empty()
+    }
+
+    /// Appends a particle at rest: zero displacement, state and flags.
+    pub fn push_new(&mut self, gid: u64, position: [f64; 2], h: f64) {
+        self.gid.push(gid);
+        self.position.push(position);
+        self.displacement.push([0.0; 2]);
+        self.h.push(h);
+        self.state.push([0.0; STATE_LEN]);
+        self.flags.push(0);
+    }
+
+    /// The particles at indices `range`, copied.
+    pub fn slice(&self, range: std::ops::Range<usize>) -> ParticleSet {
+        ParticleSet {
+            gid: self.gid[range.clone()].to_vec(),
+            position: self.position[range.clone()].to_vec(),
+            displacement: self.displacement[range.clone()].to_vec(),
+            h: self.h[range.clone()].to_vec(),
+            state: self.state[range.clone()].to_vec(),
+            flags: self.flags[range].to_vec(),
+        }
+    }
+
+    /// Moves all particles of `other` to the end of `self`.
+    pub fn append(&mut self, other: &mut ParticleSet) {
+        self.gid.append(&mut other.gid);
+        self.position.append(&mut other.position);
+        self.displacement.append(&mut other.displacement);
+        self.h.append(&mut other.h);
+        self.state.append(&mut other.state);
+        self.flags.append(&mut other.flags);
+    }
+
+    /// Names the first array whose length differs from `gid`'s.
+    pub fn check_lengths(&self) -> Result<(), String> {
+        let n = self.gid.len();
+        let lens = [
+            ("position", self.position.len()),
+            ("displacement", self.displacement.len()),
+            ("h", self.h.len()),
+            ("state", self.state.len()),
+            ("flags", self.flags.len()),
+        ];
+        match lens.iter().find(|(_, len)| *len != n) {
+            Some((name, len)) => Err(format!(
+                "particle set is inconsistent: {n} gids but {len} {name} entries"
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// `[[xmin, ymin], [xmax, ymax]]` of the positions, None when empty.
+    pub fn bounding_box(&self) -> Option<[[f64; 2]; 2]> {
+        let first = *self.position.first()?;
+        Some(self.position.iter().fold([first, first], |bb, p| {
+            [
+                [bb[0][0].min(p[0]), bb[0][1].min(p[1])],
+                [bb[1][0].max(p[0]), bb[1][1].max(p[1])],
+            ]
+        }))
+    }
+}

@@ -1,0 +1,127 @@
+//! The text of `pfem-mpi info FILE.h5`.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use super::{CaseHeader, FORMAT};
+use crate::scene::Scene;
+
+/// A number for people: plain decimals at ordinary magnitudes, exponent form otherwise.
+fn num(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || (1e-3..1e6).contains(&a) {
+        let s = format!("{x:.6}");
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        if s == "-0" { "0".to_string() } else { s.to_string() }
+    } else {
+        format!("{x:.4e}")
+    }
+}
+
+fn pair(p: [f64; 2]) -> String {
+    format!("({}, {})", num(p[0]), num(p[1]))
+}
+
+pub fn render(
+    path: &Path,
+    h: &CaseHeader,
+    n: u64,
+    gid: &[u64],
+    position: &[[f64; 2]],
+    displacement: &[[f64; 2]],
+) -> String {
+    let mut s = String::new();
+    let mut line = |label: &str, text: String| {
+        let _ = writeln!(s, "{label:<14}{text}");
+    };
+    line("file", path.display().to_string());
+    line(
+        "format",
+        format!(
+            "{FORMAT}, version {}, written by pfem-mpi {} on {} rank{}",
+            h.format_version,
+            h.code_version,
+            h.ranks,
+            if h.ranks == 1 { "" } else { "s" }
+        ),
+    );
+    let scene = Scene::from_toml(&h.scene_toml, &h.scene_source, &[]);
+    match &scene {
+        Ok(sc) => {
+            line("scene", format!("{} (from {})", sc.name, h.scene_source));
+            let mut model = format!(
+                "{}, E = {} Pa, nu = {}",
+                sc.material.model.as_str(),
+                num(sc.material.young),
+                num(sc.material.poisson)
+            );
+            if sc.material.model == crate::scene::MaterialModel::Tresca {
+                let _ = write!(model, ", cu = {} Pa", num(sc.material.cu));
+            }
+            line("material", model);
+            line(
+                "mesh",
+                format!("h = {} m, alpha = {}", num(sc.mesh.h), num(sc.mesh.alpha)),
+            );
+            line(
+                "progress",
+                format!(
+                    "step {} of {}, load factor {}, time {}",
+                    h.step,
+                    sc.steps.count,
+                    num(h.load_factor),
+                    num(h.time)
+                ),
+            );
+        }
+        Err(e) => {
+            line("scene", format!("from {} (cannot be read: {e})", h.scene_source));
+            line(
+                "progress",
+                format!("step {}, load factor {}, time {}", h.step, num(h.load_factor), num(h.time)),
+            );
+        }
+    }
+    line("particles", format!("{n} (next gid {})", h.next_gid));
+    if let Some(first) = position.first() {
+        let bb = position.iter().fold([*first, *first], |bb, p| {
+            [
+                [bb[0][0].min(p[0]), bb[0][1].min(p[1])],
+                [bb[1][0].max(p[0]), bb[1][1].max(p[1])],
+            ]
+        });
+        line(
+            "bounding box",
+            format!(
+                "x {} .. {}, y {} .. {} (m, current positions)",
+                num(bb[0][0]),
+                num(bb[1][0]),
+                num(bb[0][1]),
+                num(bb[1][1])
+            ),
+        );
+    }
+    let largest = displacement
+        .iter()
+        .enumerate()
+        .map(|(i, u)| (i, u[0].hypot(u[1])))
+        .fold(None, |best: Option<(usize, f64)>, (i, m)| match best {
+            Some((_, bm)) if bm >= m => best,
+            _ => Some((i, m)),
+        });
+    if let Some((i, m)) = largest {
+        line("displacement", format!("max |u| = {} m at gid {}", num(m), gid[i]));
+    }
+    for (k, g) in h.tracked_gids.iter().enumerate() {
+        let text = match gid.iter().position(|x| x == g) {
+            Some(i) => format!(
+                "point_load[{k}]: gid {g} at {}, u = {}",
+                pair(position[i]),
+                pair(displacement[i])
+            ),
+            None => format!("point_load[{k}]: gid {g} (no longer present)"),
+        };
+        line("tracked", text);
+    }
+    s
+}

@@ -1,0 +1,142 @@
+//! The command line (a public interface, documented in the README).
+
+use std::path::PathBuf;
+
+pub const USAGE: &str = "\
+usage:
+  pfem-mpi new <NAME|scene.toml> -o case.h5 [--set key=value ...]   write a case file
+  pfem-mpi info FILE.h5                                             summarise a case or checkpoint
+  pfem-mpi mesh FILE.h5                                             mesh it once, print its fingerprint
+  mpirun -n N pfem-mpi FILE.h5 [--out DIR] [--until-step K] [-- PETSc options]
+                                                                    run (or continue) an analysis
+built-in scenes: cantilever, footing-shallow, block-compression";
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Command {
+    New { scene: String, out: PathBuf, sets: Vec<String> },
+    Info { file: PathBuf },
+    Mesh { file: PathBuf },
+    Run { case: PathBuf, out: Option<PathBuf>, until_step: Option<u64>, petsc: Vec<String> },
+    Help,
+    Version,
+}
+
+/// Parses the arguments after the program name.
+pub fn parse(args: &[String]) -> Result<Command, String> {
+    let (ours, petsc) = match args.iter().position(|a| a == "--") {
+        Some(i) => (&args[..i], args[i + 1..].to_vec()),
+        None => (args, Vec::new()),
+    };
+    let first = ours.first().ok_or("no case file or command given")?;
+    match first.as_str() {
+        "-h" | "--help" | "help" => Ok(Command::Help),
+        "-V" | "--version" => Ok(Command::Version),
+        "new" => {
+            let mut scene = None;
+            let mut out = None;
+            let mut sets = Vec::new();
+            let mut it = ours[1..].iter();
+            while let Some(a) = it.next() {
+                match a.as_str() {
+                    "-o" | "--output" => out = Some(PathBuf::from(it.next().ok_or("-o needs a file name")?)),
+                    "--set" => sets.push(it.next().ok_or("--set needs key=value")?.clone()),
+                    s if s.starts_with('-') => return Err(format!("new: unknown option {s}")),
+                    s if scene.is_none() => scene = Some(s.to_string()),
+                    s => return Err(format!("new: unexpected argument {s}")),
+                }
+            }
+            Ok(Command::New {
+                scene: scene.ok_or("new: name a built-in scene or a scene .toml file")?,
+                out: out.ok_or("new: give the case file to write with -o case.h5")?,
+                sets,
+            })
+        }
+        "info" | "mesh" => {
+            let [file] = &ours[1..] else {
+                return Err(format!("{first}: give exactly one .h5 file"));
+            };
+            let file = PathBuf::from(file);
+            Ok(if first == "info" { Command::Info { file } } else { Command::Mesh { file } })
+        }
+        _ => {
+            let mut case = None;
+            let mut out = None;
+            let mut until_step = None;
+            let mut it = ours.iter();
+            while let Some(a) = it.next() {
+                match a.as_str() {
+                    "--out" => out = Some(PathBuf::from(it.next().ok_or("--out needs a directory")?)),
+                    "--until-step" => {
+                        let v = it.next().ok_or("--until-step needs a step number")?;
+                        until_step = Some(v.parse().map_err(|_| format!("--until-step: {v:?} is not a step number"))?);
+                    }
+                    s if s.starts_with('-') => return Err(format!("unknown option {s} (PETSc options go after --)")),
+                    s if case.is_none() => case = Some(PathBuf::from(s)),
+                    s => return Err(format!("unexpected argument {s}")),
+                }
+            }
+            Ok(Command::Run {
+                case: case.ok_or("no case file given")?,
+                out,
+                until_step,
+                petsc,
+            })
+        }
+    }
+}
+
+/// Default output folder: the case's name with `.out` (`runs/case.h5` -> `runs/case.out`); a
+/// checkpoint `X.out/checkpoints/step_N.h5` continues in `X.out`.
+pub fn default_out_dir(case: &std::path::Path) -> PathBuf {
+    if let Some(dir) = case.parent().filter(|d| d.file_name().is_some_and(|n| n == "checkpoints")) {
+        if let Some(run_dir) = dir.parent() {
+            return run_dir.to_path_buf();
+        }
+    }
+    case.with_extension("out")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(s: &str) -> Vec<String> {
+        s.split_whitespace().map(String::from).collect()
+    }
+
+    #[test]
+    fn run_with_petsc_options() {
+        let c = parse(&args("case.h5 --out r -- -snes_monitor -pc_type lu")).unwrap();
+        assert_eq!(
+            c,
+            Command::Run {
+                case: "case.h5".into(),
+                out: Some("r".into()),
+                until_step: None,
+                petsc: args("-snes_monitor -pc_type lu")
+            }
+        );
+    }
+
+    #[test]
+    fn new_with_sets() {
+        let c = parse(&args("new cantilever -o c.h5 --set mesh.h=0.25 --set steps.count=5")).unwrap();
+        assert_eq!(
+            c,
+            Command::New { scene: "cantilever".into(), out: "c.h5".into(), sets: args("mesh.h=0.25 steps.count=5") }
+        );
+    }
+
+    #[test]
+    fn errors_name_the_problem() {
+        assert!(parse(&args("new cantilever")).unwrap_err().contains("-o"));
+        assert!(parse(&args("case.h5 --until-step x")).unwrap_err().contains("--until-step"));
+        assert!(parse(&args("case.h5 -snes_monitor")).unwrap_err().contains("after --"));
+    }
+
+    #[test]
+    fn out_dir_of_case_and_checkpoint() {
+        assert_eq!(default_out_dir("a/case.h5".as_ref()), PathBuf::from("a/case.out"));
+        assert_eq!(default_out_dir("a/case.out/checkpoints/step_000010.h5".as_ref()), PathBuf::from("a/case.out"));
+    }
+}

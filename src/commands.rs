@@ -1,0 +1,100 @@
+//! The subcommands. Every one is collective: all ranks run it and all ranks exit with the same
+//! code; the error is printed once, by rank 0.
+
+use crate::case_file::{new_case, summarize, write_case};
+use crate::cli::{default_out_dir, Command};
+use crate::mesh::fingerprint::fingerprint;
+use crate::petsc::Petsc;
+use crate::run::{run, RunOptions, Simulation};
+use crate::scene::load_scene;
+use mpi::traits::Communicator;
+use pfem_partition::{agree_on_error, gather_to_root, sum_f64, Comm};
+
+/// Runs a command under MPI; returns the process exit code.
+pub fn execute(command: Command) -> i32 {
+    let Some(universe) = mpi::initialize() else {
+        eprintln!("pfem-mpi: MPI could not be initialised");
+        return 1;
+    };
+    let world = universe.world();
+    let local = match command {
+        Command::New { scene, out, sets } => new(&world, &scene, &out, &sets),
+        Command::Info { file } => {
+            if world.rank() == 0 {
+                summarize(&file).map(|s| print!("{s}")).map_err(|e| e.to_string())
+            } else {
+                Ok(())
+            }
+        }
+        Command::Mesh { file } => mesh(&world, &file),
+        Command::Run { case, out, until_step, petsc } => {
+            let out_dir = out.unwrap_or_else(|| default_out_dir(&case));
+            match Petsc::initialize(&world, &petsc) {
+                // `petsc` is dropped (PetscFinalize) before `universe` (MPI_Finalize).
+                Ok(petsc) => run(&world, &petsc, &RunOptions { case, out_dir, until_step }),
+                Err(e) => Err(e.to_string()),
+            }
+        }
+        Command::Help | Command::Version => Ok(()),
+    };
+    match agree_on_error(&world, local.err()) {
+        None => 0,
+        Some(e) => {
+            if world.rank() == 0 {
+                eprintln!("pfem-mpi: error: {e}");
+            }
+            1
+        }
+    }
+}
+
+/// Collective. Rank 0 generates the particles; all ranks write the file together.
+fn new(world: &Comm, scene: &str, out: &std::path::Path, sets: &[String]) -> Result<(), String> {
+    let (scene_v, _toml) = load_scene(scene, sets).map_err(|e| e.to_string())?;
+    let (header, mut set) = new_case(&scene_v, scene);
+    if world.rank() != 0 {
+        set = Default::default();
+    }
+    write_case(world, out, &header, &set).map_err(|e| e.to_string())?;
+    if world.rank() == 0 {
+        println!("wrote {} ({} particles, scene {})", out.display(), header_particles(&set), scene_v.name);
+    }
+    Ok(())
+}
+
+fn header_particles(set: &crate::case_file::ParticleSet) -> usize {
+    set.gid.len()
+}
+
+/// Collective. Meshes the case once and prints the rank-count independent fingerprint.
+fn mesh(world: &Comm, file: &std::path::Path) -> Result<(), String> {
+    let mut sim = Simulation::load(world, file)?;
+    let mesh = sim.remesh(world)?;
+    let owned: Vec<u64> = (0..mesh.tris.len())
+        .filter(|&t| mesh.tri_owned[t])
+        .flat_map(|t| mesh.tri_key(t))
+        .collect();
+    let boundary = mesh
+        .boundary_edges
+        .iter()
+        .filter(|e| {
+            let (a, b) = (e[0] as usize, e[1] as usize);
+            let lo = if mesh.gids[a] < mesh.gids[b] { a } else { b };
+            lo < mesh.n_owned
+        })
+        .count();
+    let counts = sum_f64(world, &[mesh.n_owned as f64, boundary as f64]);
+    let all = gather_to_root(world, &owned);
+    if world.rank() == 0 {
+        let mut tris: Vec<[u64; 3]> = all.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        tris.sort_unstable();
+        println!(
+            "fingerprint {:016x} particles {} triangles {} boundary_edges {}",
+            fingerprint(&tris),
+            counts[0] as u64,
+            tris.len(),
+            counts[1] as u64
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,7 @@
+//! Finite-element kernel: quadrature, P2 shape functions, the updated-Lagrangian element and
+//! Gauss-point recovery. Pure numerics: no MPI, no PETSc.
+
+pub mod element;
+pub mod p2;
+pub mod quadrature;
+pub mod recovery;

@@ -1,0 +1,84 @@
+//! `history.csv`: one row per step with the scene's normalised load–displacement measures.
+//! The column names are a public interface (README, "Output").
+
+use crate::scene::{HistoryKind, Scene};
+use std::fs::{self, File, OpenOptions};
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+
+pub fn columns(kind: HistoryKind) -> &'static [&'static str] {
+    match kind {
+        HistoryKind::Cantilever => &["step", "lambda", "u_over_L", "v_over_L"],
+        HistoryKind::Footing => &["step", "z_over_B", "q_over_cu"],
+        HistoryKind::Block => &["step", "strain", "stress_over_cu", "volume_ratio"],
+    }
+}
+
+/// Global measurements of a step, gathered by the driver.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Measures {
+    pub load_factor: f64,
+    /// Total displacement of the first tracked particle.
+    pub tracked_displacement: [f64; 2],
+}
+
+/// Normalised values of a row (after `step`).
+pub fn row(scene: &Scene, m: &Measures) -> Result<Vec<f64>, String> {
+    match scene.history.kind {
+        HistoryKind::Cantilever => {
+            let beam = scene.body.rectangles.first().ok_or("body.rectangles: empty")?;
+            let load = scene.point_load.first().ok_or("history.kind = \"cantilever\" needs a [[point_load]]")?;
+            let (l, d) = (beam.size[0], beam.size[1]);
+            let ei = scene.material.young * d.powi(3) / 12.0;
+            let p = (load.force[0].powi(2) + load.force[1].powi(2)).sqrt();
+            Ok(vec![
+                m.load_factor * p * l * l / ei,
+                -m.tracked_displacement[0] / l,
+                -m.tracked_displacement[1] / l,
+            ])
+        }
+        other => Err(format!("history.kind = \"{}\" is not available in this build yet", other.as_str())),
+    }
+}
+
+/// Appends rows to `DIR/history.csv`; on a restart from step k it keeps rows up to k.
+pub struct HistoryFile {
+    file: File,
+    pub path: PathBuf,
+}
+
+impl HistoryFile {
+    pub fn open(dir: &Path, kind: HistoryKind, restart_step: u64) -> Result<HistoryFile, String> {
+        let path = dir.join("history.csv");
+        let header = columns(kind).join(",");
+        let mut kept = vec![header.clone()];
+        if restart_step > 0 && path.exists() {
+            let f = File::open(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let mut lines = BufReader::new(f).lines();
+            match lines.next() {
+                Some(Ok(h)) if h == header => {}
+                _ => return Err(format!("{}: columns differ from {header:?}; move it away to restart here", path.display())),
+            }
+            for line in lines {
+                let line = line.map_err(|e| format!("{}: {e}", path.display()))?;
+                let step: Option<u64> = line.split(',').next().and_then(|s| s.trim().parse().ok());
+                if matches!(step, Some(s) if s <= restart_step) {
+                    kept.push(line);
+                }
+            }
+        }
+        let tmp = path.with_extension("csv.tmp");
+        fs::write(&tmp, kept.join("\n") + "\n").map_err(|e| format!("{}: {e}", tmp.display()))?;
+        fs::rename(&tmp, &path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let file = OpenOptions::new().append(true).open(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok(HistoryFile { file, path })
+    }
+
+    pub fn append(&mut self, step: u64, values: &[f64]) -> Result<(), String> {
+        let mut line = step.to_string();
+        for v in values {
+            line.push_str(&format!(",{v:.10e}"));
+        }
+        writeln!(self.file, "{line}").map_err(|e| format!("{}: {e}", self.path.display()))
+    }
+}

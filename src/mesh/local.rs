@@ -1,0 +1,114 @@
+//! The mesh one rank works on: Delaunay of its owned particles plus the halo, filtered by the alpha
+//! shape, restricted to triangles that touch an owned particle. With a halo at least
+//! `2 * alpha * h_max` wide these triangles are exactly the global mesh's triangles around the owned
+//! particles, bit for bit on every rank that holds them (see `halo_width`).
+
+use super::alpha::{alpha_keep, boundary_edges};
+use super::delaunay::delaunay;
+use std::collections::HashMap;
+
+/// Every kept triangle has circumradius R <= alpha*h and an owned vertex on its circumcircle, so its
+/// circumdisk lies within 2R of that vertex: every particle that could spoil the empty-circle test
+/// is within `2*alpha*h_max`. The 5 % margin covers particles moved by refinement in the same step.
+pub fn halo_width(alpha: f64, h_max: f64) -> f64 {
+    2.0 * alpha * h_max * 1.05
+}
+
+#[derive(Debug, Clone)]
+pub struct LocalMesh {
+    /// Owned particles first (`0..n_owned`, sorted by global id), then ghosts.
+    pub points: Vec<[f64; 2]>,
+    pub gids: Vec<u64>,
+    pub n_owned: usize,
+    /// Rank owning each local point.
+    pub owner: Vec<i32>,
+    /// Kept triangles touching an owned particle, CCW, smallest-gid vertex first, sorted by gids.
+    pub tris: Vec<[u32; 3]>,
+    /// Whether this rank owns the triangle: the owner of its smallest-gid vertex (fixed rule).
+    pub tri_owned: Vec<bool>,
+    /// Owned particles on the alpha-shape boundary.
+    pub on_boundary: Vec<bool>,
+    /// Boundary edges touching an owned particle (body on the left).
+    pub boundary_edges: Vec<[u32; 2]>,
+}
+
+#[derive(Debug)]
+pub struct MeshError(pub String);
+
+impl std::fmt::Display for MeshError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl LocalMesh {
+    /// Builds the rank-local mesh. `h` is the local spacing per point (same order as `points`).
+    pub fn build(
+        points: Vec<[f64; 2]>,
+        gids: Vec<u64>,
+        owner: Vec<i32>,
+        h: &[f64],
+        n_owned: usize,
+        rank: i32,
+        alpha: f64,
+    ) -> Result<LocalMesh, MeshError> {
+        let all = delaunay(&points, &gids).map_err(|e| MeshError(format!("Delaunay triangulation failed: {e}")))?;
+        let keep = alpha_keep(&points, &all, h, alpha);
+        let mut tris: Vec<[u32; 3]> = all
+            .iter()
+            .zip(&keep)
+            .filter(|(t, &k)| k && t.iter().any(|&v| (v as usize) < n_owned))
+            .map(|(t, _)| canonical(*t, &gids))
+            .collect();
+        tris.sort_by_key(|t| key(t, &gids));
+        let tri_owned = tris.iter().map(|t| owner[t[0] as usize] == rank).collect();
+        let bedges: Vec<[u32; 2]> = boundary_edges(&tris)
+            .into_iter()
+            .filter(|e| (e[0] as usize) < n_owned || (e[1] as usize) < n_owned)
+            .collect();
+        let mut on_boundary = vec![false; n_owned];
+        for e in &bedges {
+            for &v in e {
+                if (v as usize) < n_owned {
+                    on_boundary[v as usize] = true;
+                }
+            }
+        }
+        Ok(LocalMesh {
+            points,
+            gids,
+            n_owned,
+            owner,
+            tris,
+            tri_owned,
+            on_boundary,
+            boundary_edges: bedges,
+        })
+    }
+
+    /// The triangle's global-id key (smallest gid first, CCW).
+    pub fn tri_key(&self, t: usize) -> [u64; 3] {
+        key(&self.tris[t], &self.gids)
+    }
+
+    /// Local index of each global id present on this rank.
+    pub fn index_of(&self) -> HashMap<u64, u32> {
+        self.gids.iter().enumerate().map(|(i, &g)| (g, i as u32)).collect()
+    }
+
+    /// Number of owned triangles (for balance and the fingerprint).
+    pub fn n_owned_tris(&self) -> usize {
+        self.tri_owned.iter().filter(|&&o| o).count()
+    }
+}
+
+fn key(t: &[u32; 3], gids: &[u64]) -> [u64; 3] {
+    [gids[t[0] as usize], gids[t[1] as usize], gids[t[2] as usize]]
+}
+
+/// Rotates a CCW triangle so its smallest-gid vertex comes first; orientation is kept.
+fn canonical(t: [u32; 3], gids: &[u64]) -> [u32; 3] {
+    let g = key(&t, gids);
+    let m = (0..3).min_by_key(|&i| g[i]).unwrap_or(0);
+    [t[m], t[(m + 1) % 3], t[(m + 2) % 3]]
+}

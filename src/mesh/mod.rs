@@ -1,0 +1,11 @@
+//! Meshing of the particle cloud: exact predicates, Delaunay, alpha shape, the rank-local mesh,
+//! refinement and the rank-count independent fingerprint.
+
+pub mod alpha;
+pub mod delaunay;
+pub mod fingerprint;
+pub mod local;
+pub mod predicates;
+pub mod refine;
+
+pub use local::LocalMesh;

@@ -1,0 +1,161 @@
+//! Mesh-quality control of the method's Fig. 4, as local decisions that every rank takes
+//! identically: they read only the rank-local mesh around owned particles (equal to the global
+//! mesh there) and break ties by global id. Applying them (new ids, moving state) is the driver's.
+
+use super::LocalMesh;
+use std::collections::BTreeSet;
+
+/// Thresholds in units of the local spacing h.
+#[derive(Debug, Clone, Copy)]
+pub struct RefineParams {
+    /// Split an edge longer than this (a lattice diagonal is sqrt(2) = 1.41).
+    pub split_length: f64,
+    /// Remove a particle closer than this to a neighbour with a smaller global id.
+    pub merge_distance: f64,
+    /// Move interior particles to the centroid of their neighbours.
+    pub smooth: bool,
+}
+
+impl Default for RefineParams {
+    fn default() -> Self {
+        RefineParams {
+            split_length: 1.6,
+            merge_distance: 0.4,
+            smooth: false,
+        }
+    }
+}
+
+/// What to change, in local indices of `mesh.points`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Plan {
+    /// Edges (smaller-gid endpoint owned here) that get a particle at their midpoint.
+    pub split: Vec<[u32; 2]>,
+    /// Owned particles to remove.
+    pub remove: Vec<u32>,
+    /// Owned interior particles and their smoothed positions.
+    pub smooth: Vec<(u32, [f64; 2])>,
+}
+
+impl Plan {
+    pub fn is_empty(&self) -> bool {
+        self.split.is_empty() && self.remove.is_empty() && self.smooth.is_empty()
+    }
+}
+
+/// Plans refinement of `mesh`. `h[p]` is the spacing of local point p; `protected(p)` marks owned
+/// particles that must neither move nor vanish (tracked, constrained or boundary particles).
+pub fn plan(mesh: &LocalMesh, h: &[f64], protected: impl Fn(usize) -> bool, params: &RefineParams) -> Plan {
+    let n = mesh.n_owned;
+    let mut edges: BTreeSet<(u64, u64, u32, u32)> = BTreeSet::new();
+    let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for t in &mesh.tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let (ga, gb) = (mesh.gids[a as usize], mesh.gids[b as usize]);
+            let (lo, hi) = if ga < gb { (a, b) } else { (b, a) };
+            if (lo as usize) < n {
+                edges.insert((ga.min(gb), ga.max(gb), lo, hi));
+            }
+            for (p, q) in [(a, b), (b, a)] {
+                if (p as usize) < n {
+                    neighbours[p as usize].push(q);
+                }
+            }
+        }
+    }
+    let dist = |a: u32, b: u32| {
+        let (p, q) = (mesh.points[a as usize], mesh.points[b as usize]);
+        ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
+    };
+    let spacing = |a: u32, b: u32| 0.5 * (h[a as usize] + h[b as usize]);
+    let split: Vec<[u32; 2]> = edges
+        .iter()
+        .filter(|&&(_, _, a, b)| dist(a, b) > params.split_length * spacing(a, b))
+        .map(|&(_, _, a, b)| [a, b])
+        .collect();
+    let mut remove = Vec::new();
+    let mut smooth = Vec::new();
+    for (p, nb) in neighbours.iter_mut().enumerate() {
+        nb.sort_unstable();
+        nb.dedup();
+        if protected(p) || nb.is_empty() {
+            continue;
+        }
+        let pu = p as u32;
+        let close = nb
+            .iter()
+            .any(|&q| mesh.gids[q as usize] < mesh.gids[p] && dist(pu, q) < params.merge_distance * spacing(pu, q));
+        if close {
+            remove.push(pu);
+        } else if params.smooth && !mesh.on_boundary[p] {
+            let mut c = [0.0; 2];
+            for &q in nb.iter() {
+                c[0] += mesh.points[q as usize][0];
+                c[1] += mesh.points[q as usize][1];
+            }
+            let k = nb.len() as f64;
+            let target = [c[0] / k, c[1] / k];
+            if dist_to(mesh.points[p], target) > 1e-3 * h[p] {
+                smooth.push((pu, target));
+            }
+        }
+    }
+    Plan { split, remove, smooth }
+}
+
+fn dist_to(p: [f64; 2], q: [f64; 2]) -> f64 {
+    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lattice(nx: usize, ny: usize, h: f64, jitter: impl Fn(usize) -> [f64; 2]) -> LocalMesh {
+        let mut pts = Vec::new();
+        for j in 0..ny {
+            for i in 0..nx {
+                let d = jitter(j * nx + i);
+                pts.push([i as f64 * h + d[0], j as f64 * h + d[1]]);
+            }
+        }
+        let n = pts.len();
+        let gids = (0..n as u64).collect();
+        LocalMesh::build(pts, gids, vec![0; n], &vec![h; n], n, 0, 1.3).unwrap()
+    }
+
+    #[test]
+    fn regular_lattice_needs_nothing() {
+        let m = lattice(6, 5, 0.5, |_| [0.0, 0.0]);
+        let h = vec![0.5; m.points.len()];
+        let p = plan(&m, &h, |_| false, &RefineParams::default());
+        assert!(p.is_empty(), "{p:?}");
+    }
+
+    #[test]
+    fn close_pair_loses_the_larger_id_and_long_edges_split() {
+        // Particle 8 (interior) pushed next to particle 7.
+        let m = lattice(5, 5, 1.0, |i| if i == 12 { [-0.7, 0.0] } else { [0.0, 0.0] });
+        let h = vec![1.0; m.points.len()];
+        let p = plan(&m, &h, |_| false, &RefineParams::default());
+        assert_eq!(p.remove, vec![12]);
+        assert!(!p.split.is_empty(), "the gap left at x = 2 has long edges");
+        for [a, b] in &p.split {
+            assert!(m.gids[*a as usize] < m.gids[*b as usize]);
+        }
+    }
+
+    #[test]
+    fn smoothing_moves_only_interior_unprotected_particles() {
+        let m = lattice(5, 5, 1.0, |i| if i == 12 { [0.2, 0.1] } else { [0.0, 0.0] });
+        let h = vec![1.0; m.points.len()];
+        let params = RefineParams { smooth: true, ..Default::default() };
+        let p = plan(&m, &h, |_| false, &params);
+        assert!(p.smooth.iter().all(|(i, _)| !m.on_boundary[*i as usize]));
+        let (_, target) = p.smooth.iter().find(|(i, _)| *i == 12).expect("12 is smoothed");
+        assert!(dist_to(*target, [2.0, 2.0]) < 0.1);
+        let none = plan(&m, &h, |i| i == 12, &params);
+        assert!(none.smooth.iter().all(|(i, _)| *i != 12));
+    }
+}

@@ -1,0 +1,118 @@
+//! The particles one rank owns, sorted by global id, and the halo copies of its neighbours'.
+
+use crate::material::GaussState;
+use pfem_partition::{Comm, Halo, PartitionError};
+
+/// Per-particle flags.
+pub mod flag {
+    /// Tracked by a point load: never removed or smoothed.
+    pub const TRACKED: u32 = 1;
+}
+
+/// Owned particles (structure of arrays, sorted by global id).
+#[derive(Debug, Clone, Default)]
+pub struct Particles {
+    pub gid: Vec<u64>,
+    pub position: Vec<[f64; 2]>,
+    /// Total displacement since the start of the analysis; position − displacement is the
+    /// reference position that boundary selectors look at.
+    pub displacement: Vec<[f64; 2]>,
+    /// Target spacing.
+    pub h: Vec<f64>,
+    /// State carried by the particle (Gauss state recovered at the particle).
+    pub state: Vec<[f64; GaussState::LEN]>,
+    pub flags: Vec<u32>,
+}
+
+/// Copies of other ranks' particles near ours, bit for bit, in the halo's ghost order.
+#[derive(Debug, Clone, Default)]
+pub struct Ghosts {
+    pub gid: Vec<u64>,
+    pub owner: Vec<i32>,
+    pub position: Vec<[f64; 2]>,
+    pub displacement: Vec<[f64; 2]>,
+    pub h: Vec<f64>,
+    pub state: Vec<[f64; GaussState::LEN]>,
+}
+
+/// f64 record per particle in a halo exchange: position, displacement, h, state.
+pub const RECORD: usize = 5 + GaussState::LEN;
+
+impl Particles {
+    pub fn len(&self) -> usize {
+        self.gid.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.gid.is_empty()
+    }
+
+    pub fn reference_position(&self, i: usize) -> [f64; 2] {
+        [
+            self.position[i][0] - self.displacement[i][0],
+            self.position[i][1] - self.displacement[i][1],
+        ]
+    }
+
+    /// Sorts by global id (the invariant every other structure relies on).
+    pub fn sort_by_gid(&mut self) {
+        let mut order: Vec<usize> = (0..self.len()).collect();
+        order.sort_by_key(|&i| self.gid[i]);
+        self.gid = order.iter().map(|&i| self.gid[i]).collect();
+        self.position = order.iter().map(|&i| self.position[i]).collect();
+        self.displacement = order.iter().map(|&i| self.displacement[i]).collect();
+        self.h = order.iter().map(|&i| self.h[i]).collect();
+        self.state = order.iter().map(|&i| self.state[i]).collect();
+        self.flags = order.iter().map(|&i| self.flags[i]).collect();
+    }
+
+    /// Flattens the f64 fields for exchange and migration.
+    pub fn records(&self) -> Vec<f64> {
+        let mut out = Vec::with_capacity(self.len() * RECORD);
+        for i in 0..self.len() {
+            out.extend_from_slice(&self.position[i]);
+            out.extend_from_slice(&self.displacement[i]);
+            out.push(self.h[i]);
+            out.extend_from_slice(&self.state[i]);
+        }
+        out
+    }
+
+    /// Rebuilds from global ids, flattened records and flags.
+    pub fn from_records(gid: Vec<u64>, rec: &[f64], flags: Vec<u32>) -> Particles {
+        let mut p = Particles {
+            gid,
+            flags,
+            ..Default::default()
+        };
+        for r in rec.chunks_exact(RECORD) {
+            p.position.push([r[0], r[1]]);
+            p.displacement.push([r[2], r[3]]);
+            p.h.push(r[4]);
+            let mut s = [0.0; GaussState::LEN];
+            s.copy_from_slice(&r[5..RECORD]);
+            p.state.push(s);
+        }
+        p
+    }
+
+    /// Collective. Builds the halo of width `width` and copies the neighbours' particles.
+    pub fn ghosts(&self, comm: &Comm, width: f64) -> Result<(Halo, Ghosts), PartitionError> {
+        let halo = Halo::build(comm, &self.gid, &self.position, width)?;
+        let rec = halo.exchange_f64(comm, &self.records(), RECORD);
+        let mut g = Ghosts {
+            gid: halo.ghost_ids().to_vec(),
+            owner: halo.ghost_owners().to_vec(),
+            ..Default::default()
+        };
+        for r in rec.chunks_exact(RECORD) {
+            g.position.push([r[0], r[1]]);
+            g.displacement.push([r[2], r[3]]);
+            g.h.push(r[4]);
+            let mut s = [0.0; GaussState::LEN];
+            s.copy_from_slice(&r[5..RECORD]);
+            g.state.push(s);
+        }
+        Ok((halo, g))
+    }
+}

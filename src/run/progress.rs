@@ -1,0 +1,72 @@
+//! Rank-0 progress lines with a timer per phase, as in deal.II's step-40.
+
+use super::{Simulation, StepReport};
+use mpi::traits::Communicator;
+use pfem_partition::Comm;
+use std::io::IsTerminal;
+use std::time::Instant;
+
+#[derive(Default)]
+pub struct PhaseTimer {
+    phases: Vec<(&'static str, f64)>,
+}
+
+impl PhaseTimer {
+    pub fn time<R>(&mut self, name: &'static str, f: impl FnOnce() -> R) -> R {
+        let t = Instant::now();
+        let r = f();
+        self.phases.push((name, t.elapsed().as_secs_f64()));
+        r
+    }
+
+    pub fn total(&self) -> f64 {
+        self.phases.iter().map(|p| p.1).sum()
+    }
+}
+
+pub struct Progress {
+    root: bool,
+    every: u64,
+    total: u64,
+    started: Instant,
+}
+
+impl Progress {
+    pub fn new(world: &Comm, total: u64) -> Progress {
+        let tty = std::io::stdout().is_terminal();
+        Progress {
+            root: world.rank() == 0,
+            every: if tty { 1 } else { (total / 20).max(1) },
+            total,
+            started: Instant::now(),
+        }
+    }
+
+    pub fn step(&mut self, sim: &Simulation, r: &StepReport, t: &PhaseTimer) {
+        let step = sim.step();
+        if !self.root || (step % self.every != 0 && step != self.total) {
+            return;
+        }
+        let phases: Vec<String> = t.phases.iter().map(|(n, s)| format!("{n} {s:.3}")).collect();
+        let done = step.saturating_sub(sim.first_step()) as f64;
+        let left = (self.total - step) as f64 * self.started.elapsed().as_secs_f64() / done.max(1.0);
+        println!(
+            "step {step:>5}/{} load {:.4} newton {:>2} |R| {:.2e} particles {} triangles {} | {} | step {:.3}s left {:.0}s",
+            self.total,
+            sim.load_factor(),
+            r.newton_iterations,
+            r.residual_norm,
+            r.particles,
+            r.triangles,
+            phases.join(" "),
+            t.total(),
+            left
+        );
+    }
+
+    pub fn finish(&self, sim: &Simulation) {
+        if self.root {
+            println!("done: step {} in {:.2} s", sim.step(), self.started.elapsed().as_secs_f64());
+        }
+    }
+}

@@ -1,0 +1,207 @@
+//! Scenes: the problem description a user runs, as a TOML document (SI units).
+//!
+//! A scene is either a built-in (`cantilever`, `footing-shallow`, `block-compression`) or a
+//! `.toml` file. `--set a.b.c=value` overrides are applied to the TOML tree before it is read,
+//! and every table rejects unknown keys, so typos are errors that name the key. Layout:
+//!
+//! ```toml
+//! name = "cantilever"
+//! [body]                # union of axis-aligned rectangles filled with a particle lattice
+//! rectangles = [ { origin = [0.0, 0.0], size = [10.0, 1.0] } ]
+//! [mesh]
+//! h = 0.125             # particle spacing (m)
+//! alpha = 1.3           # alpha shape: keep triangles with circumradius <= alpha*h (default 1.3)
+//! refine = true         # particle insertion/removal (default true)
+//! smooth = false        # Laplacian smoothing of interior particles (default false)
+//! [material]
+//! model = "linear-elastic"   # or "tresca"
+//! young = 12.0e6             # Pa
+//! poisson = 0.2
+//! density = 0.0              # kg/m3 (default 0); body force = density * gravity.g
+//! cu = 0.0                   # Pa, undrained shear strength, "tresca" only (default 0)
+//! [gravity]                  # optional
+//! g = [0.0, 0.0]             # m/s2
+//! [[fixed]]                  # zero displacement; selection re-evaluated on every remesh
+//! where = "x <= 0"           # "x <= c", "x >= c", "y <= c", "y >= c" joined by "and"
+//! dofs = ["x", "y"]
+//! [[point_load]]             # force on the particle nearest to `at` when the case is created
+//! at = [10.0, 0.5]
+//! force = [0.0, -100.0e3]    # N per metre thickness at load factor 1
+//! [[prescribed]]             # imposed displacement of the selected particles
+//! where = "y >= 10 and x <= 1"
+//! dofs = ["y"]
+//! total = [0.0, -0.1]        # m, reached at the end of loading, applied linearly
+//! [steps]
+//! count = 50
+//! [history]
+//! kind = "cantilever"        # "cantilever" | "footing" | "block": history.csv columns
+//! [output]                   # optional
+//! checkpoint_every = 0       # 0 = only at the end (default 0)
+//! checkpoint_keep = 3        # (default 3)
+//! [solver]                   # optional
+//! newton_max_it = 25         # (default 25)
+//! newton_rtol = 1e-9         # (default 1e-9)
+//! ```
+//!
+//! The field-by-field reference, with the validation rules, is on the types in [`schema`].
+
+#[path = "scene/builtin.rs"]
+pub mod builtin;
+#[path = "scene/error.rs"]
+mod error;
+#[path = "scene/field_path.rs"]
+mod field_path;
+#[path = "scene/lattice.rs"]
+pub mod lattice;
+#[path = "scene/overrides.rs"]
+mod overrides;
+#[path = "scene/schema.rs"]
+pub mod schema;
+#[path = "scene/selector.rs"]
+pub mod selector;
+#[path = "scene/validate.rs"]
+mod validate;
+#[path = "scene/value_de.rs"]
+mod value_de;
+
+use std::borrow::Cow;
+use std::path::Path;
+
+use serde::Deserialize;
+
+pub use builtin::{builtin, builtin_names, BUILTINS};
+pub use error::SceneError;
+pub use lattice::generate_particles;
+pub use schema::{
+    Body, Dof, Fixed, Gravity, History, HistoryKind, Material, MaterialModel, Mesh, Output,
+    PointLoad, Prescribed, Rectangle, Scene, Solver, Steps,
+};
+pub use selector::{Axis, Comparison, Condition, Selector};
+
+use field_path::FieldPath;
+use overrides::SetArg;
+use value_de::{DeErrorKind, ValueDeserializer};
+
+/// 1-based line and column of a byte offset, for TOML syntax errors.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+/// The `--set` argument (last one wins) whose path overlaps `path`.
+fn responsible_set<'a>(sets: &'a [SetArg], path: &FieldPath) -> Option<&'a SetArg> {
+    sets.iter().rev().find(|s| s.path.overlaps(path))
+}
+
+impl Scene {
+    /// Parses, overrides and validates a scene from TOML text. `source` names the scene in
+    /// errors (file path or built-in name); `sets` are `--set` arguments (`a.b.c=value`).
+    pub fn from_toml(text: &str, source: &str, sets: &[String]) -> Result<Scene, SceneError> {
+        let mut table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+            let (line, column) = line_column(text, e.span().map_or(0, |s| s.start));
+            SceneError::new(
+                source,
+                format!(
+                    "invalid TOML at line {line}, column {column}: {}",
+                    e.message().trim().replace('\n', "; ")
+                ),
+            )
+        })?;
+
+        let mut parsed = Vec::with_capacity(sets.len());
+        for raw in sets {
+            let set = SetArg::parse(raw).map_err(|message| SceneError {
+                set: Some(raw.clone()),
+                ..SceneError::new(source, message)
+            })?;
+            set.apply(&mut table).map_err(|(path, message)| SceneError {
+                set: Some(raw.clone()),
+                field: Some(path.to_string()),
+                ..SceneError::new(source, message)
+            })?;
+            parsed.push(set);
+        }
+
+        let tree = toml::Value::Table(table);
+        let scene = Scene::deserialize(ValueDeserializer::new(&tree)).map_err(|e| {
+            let set = responsible_set(&parsed, &e.path);
+            let message = match (e.kind, set) {
+                (DeErrorKind::UnknownKey, Some(_)) => {
+                    format!("no such key in the scene schema ({})", e.message)
+                }
+                _ => e.message,
+            };
+            SceneError {
+                set: set.map(|s| s.raw.clone()),
+                field: (!e.path.is_empty()).then(|| e.path.to_string()),
+                ..SceneError::new(source, message)
+            }
+        })?;
+
+        validate::validate(&scene).map_err(|(path, message)| SceneError {
+            set: responsible_set(&parsed, &path).map(|s| s.raw.clone()),
+            field: Some(path.to_string()),
+            ..SceneError::new(source, message)
+        })?;
+        Ok(scene)
+    }
+
+    /// The complete scene, defaults included, as TOML. [`Scene::from_toml`] reads it back to an
+    /// equal scene (floats are written in shortest round-trip form).
+    pub fn to_toml(&self) -> String {
+        // toml refuses only shapes a Scene never has (bare None, non-string keys, integers
+        // beyond i64): every field is a string, f64, u32, bool, array or table.
+        toml::to_string(self).expect("a Scene always has a TOML representation")
+    }
+
+    /// `[[xmin, ymin], [xmax, ymax]]` of the body rectangles.
+    pub fn bounding_box(&self) -> [[f64; 2]; 2] {
+        let mut bb = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
+        for r in &self.body.rectangles {
+            for axis in 0..2 {
+                bb[0][axis] = bb[0][axis].min(r.origin[axis]);
+                bb[1][axis] = bb[1][axis].max(r.origin[axis] + r.size[axis]);
+            }
+        }
+        bb
+    }
+
+    /// Boundary slack of geometric selections: 1e-9 times the body's largest dimension.
+    pub fn tolerance(&self) -> f64 {
+        let bb = self.bounding_box();
+        1e-9 * (bb[1][0] - bb[0][0]).max(bb[1][1] - bb[0][1])
+    }
+}
+
+/// Loads a built-in scene by name or a scene file by path (anything ending in `.toml` or
+/// containing a `/` is a path), applies `--set` overrides and validates. Returns the scene and
+/// its resolved TOML (overrides and defaults applied), which is what a case file records.
+pub fn load_scene(name_or_path: &str, sets: &[String]) -> Result<(Scene, String), SceneError> {
+    let is_path = name_or_path.ends_with(".toml")
+        || name_or_path.contains('/')
+        || name_or_path.contains(std::path::MAIN_SEPARATOR);
+    let text: Cow<'static, str> = match builtin(name_or_path) {
+        Some(text) if !is_path => Cow::Borrowed(text),
+        _ if !is_path && !Path::new(name_or_path).exists() => {
+            return Err(SceneError::new(
+                name_or_path,
+                format!(
+                    "no built-in scene of that name (built-ins: {}) and no such file",
+                    builtin_names()
+                ),
+            ));
+        }
+        _ => Cow::Owned(std::fs::read_to_string(name_or_path).map_err(|e| {
+            SceneError::new(name_or_path, format!("cannot read the scene file: {e}"))
+        })?),
+    };
+    let scene = Scene::from_toml(&text, name_or_path, sets)?;
+    let resolved = scene.to_toml();
+    Ok((scene, resolved))
+}
+
+#[cfg(test)]
+#[path = "scene/tests.rs"]
+mod tests;

@@ -1,0 +1,26 @@
+//! Scenes shipped with the program, selected by name instead of a file path. Their TOML sources
+//! live next to this file so that users can copy one as a starting point.
+
+/// `(name, TOML text)` of every built-in scene.
+pub const BUILTINS: &[(&str, &str)] = &[
+    ("cantilever", include_str!("builtin/cantilever.toml")),
+    ("footing-shallow", include_str!("builtin/footing-shallow.toml")),
+    ("block-compression", include_str!("builtin/block-compression.toml")),
+];
+
+/// TOML text of the built-in scene `name`.
+pub fn builtin(name: &str) -> Option<&'static str> {
+    BUILTINS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, text)| *text)
+}
+
+/// Names of the built-in scenes, comma separated, for error messages and help.
+pub fn builtin_names() -> String {
+    BUILTINS
+        .iter()
+        .map(|(n, _)| *n)
+        .collect::<Vec<_>>()
+        .join(", ")
+}

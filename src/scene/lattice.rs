@@ -1,0 +1,194 @@
+//! The initial particle lattice: one global square grid of spacing `mesh.h` anchored at the
+//! first rectangle's origin, restricted to the union of the body rectangles. Using one grid for
+//! all rectangles is what makes particles on shared edges coincide, so each is emitted once.
+
+use super::schema::{Rectangle, Scene};
+use crate::case_file::ParticleSet;
+
+/// Allowed deviation, in spacings, of a rectangle corner from a lattice line.
+pub const ALIGN_TOL: f64 = 1e-6;
+
+/// Rounds `x` to the nearest integer when it is one within `ALIGN_TOL`.
+pub fn whole(x: f64) -> Option<i64> {
+    let r = x.round();
+    ((x - r).abs() <= ALIGN_TOL && r.abs() < 9.0e15).then_some(r as i64)
+}
+
+/// Inclusive lattice index ranges `([i0, i1], [j0, j1])` covered by a rectangle, or None when
+/// the rectangle is not aligned with the lattice.
+pub fn index_box(anchor: [f64; 2], h: f64, r: &Rectangle) -> Option<([i64; 2], [i64; 2])> {
+    let mut out = [[0i64; 2]; 2];
+    for axis in 0..2 {
+        let start = whole((r.origin[axis] - anchor[axis]) / h)?;
+        let count = whole(r.size[axis] / h)?;
+        out[axis] = [start, start + count];
+    }
+    Some((out[0], out[1]))
+}
+
+/// For each lattice row `j` (ascending), the merged `[i0, i1]` intervals of the rectangles
+/// covering it. Rectangles must already be validated as aligned.
+fn rows(anchor: [f64; 2], h: f64, rects: &[Rectangle]) -> Vec<(i64, Vec<[i64; 2]>)> {
+    let boxes: Vec<_> = rects
+        .iter()
+        .filter_map(|r| index_box(anchor, h, r))
+        .collect();
+    let (Some(jmin), Some(jmax)) = (
+        boxes.iter().map(|b| b.1[0]).min(),
+        boxes.iter().map(|b| b.1[1]).max(),
+    ) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for j in jmin..=jmax {
+        let mut spans: Vec<[i64; 2]> = boxes
+            .iter()
+            .filter(|b| b.1[0] <= j && j <= b.1[1])
+            .map(|b| b.0)
+            .collect();
+        spans.sort_unstable();
+        let mut merged: Vec<[i64; 2]> = Vec::with_capacity(spans.len());
+        for s in spans {
+            match merged.last_mut() {
+                // Spans sharing an index (a common edge) or overlapping merge, so that no
+                // particle is emitted twice.
+                Some(last) if s[0] <= last[1] => last[1] = last[1].max(s[1]),
+                _ => merged.push(s),
+            }
+        }
+        if !merged.is_empty() {
+            out.push((j, merged));
+        }
+    }
+    out
+}
+
+/// Number of particles `generate_particles` would produce, without producing them.
+pub fn particle_count(scene: &Scene) -> u64 {
+    let Some(first) = scene.body.rectangles.first() else {
+        return 0;
+    };
+    rows(first.origin, scene.mesh.h, &scene.body.rectangles)
+        .iter()
+        .flat_map(|(_, spans)| spans.iter())
+        .map(|s| (s[1] - s[0] + 1) as u64)
+        .sum()
+}
+
+/// Fills the body rectangles with a square lattice of spacing `mesh.h`, rectangle edges
+/// included. Global ids are `0..n` in row-major order (by y, then x); every particle gets
+/// `h = mesh.h`, zero displacement, zero state and zero flags.
+pub fn generate_particles(scene: &Scene) -> ParticleSet {
+    let h = scene.mesh.h;
+    let Some(first) = scene.body.rectangles.first() else {
+        return ParticleSet::default();
+    };
+    let anchor = first.origin;
+    let mut set = ParticleSet::with_capacity(particle_count(scene) as usize);
+    for (j, spans) in rows(anchor, h, &scene.body.rectangles) {
+        let y = anchor[1] + j as f64 * h;
+        for span in spans {
+            for i in span[0]..=span[1] {
+                let gid = set.len() as u64;
+                set.push_new(gid, [anchor[0] + i as f64 * h, y], h);
+            }
+        }
+    }
+    set
+}
+
+/// Global id of the particle nearest to `p` (ties go to the smaller id), with its distance.
+pub fn nearest(set: &ParticleSet, p: [f64; 2]) -> Option<(u64, f64)> {
+    let mut best: Option<(u64, f64)> = None;
+    for (gid, q) in set.gid.iter().zip(&set.position) {
+        let d2 = (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
+        let better = match best {
+            None => true,
+            Some((bg, bd2)) => d2 < bd2 || (d2 == bd2 && *gid < bg),
+        };
+        if better {
+            best = Some((*gid, d2));
+        }
+    }
+    best.map(|(g, d2)| (g, d2.sqrt()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+    use std::collections::HashSet;
+
+    fn scene_with(rects: &str, h: f64) -> Scene {
+        let text = format!(
+            r#"
+name = "t"
+[body]
+rectangles = {rects}
+[mesh]
+h = {h}
+[material]
+model = "linear-elastic"
+young = 1.0e6
+poisson = 0.3
+[[point_load]]
+at = [0.0, 0.0]
+force = [0.0, -1.0]
+[steps]
+count = 1
+[history]
+kind = "cantilever"
+"#
+        );
+        Scene::from_toml(&text, "test", &[]).unwrap()
+    }
+
+    #[test]
+    fn cantilever_lattice_is_81_by_9() {
+        let s = scene_with("[ { origin = [0.0, 0.0], size = [10.0, 1.0] } ]", 0.125);
+        let p = generate_particles(&s);
+        assert_eq!(p.len(), 81 * 9);
+        assert_eq!(particle_count(&s), 81 * 9);
+        assert_eq!(p.gid, (0..729).collect::<Vec<u64>>());
+        // Row-major by y then x.
+        assert_eq!(p.position[0], [0.0, 0.0]);
+        assert_eq!(p.position[80], [10.0, 0.0]);
+        assert_eq!(p.position[81], [0.0, 0.125]);
+        assert_eq!(p.position[728], [10.0, 1.0]);
+        assert!(p.h.iter().all(|&h| h == 0.125));
+        assert!(p.state.iter().all(|s| s.iter().all(|&v| v == 0.0)));
+    }
+
+    #[test]
+    fn shared_edges_are_not_duplicated() {
+        // An L shape: a 2x1 base and a 1x1 block on top sharing the edge y = 1, plus a block on
+        // the right sharing the edge x = 2 and overlapping the base's corner.
+        let s = scene_with(
+            "[ { origin = [0.0, 0.0], size = [2.0, 1.0] }, \
+               { origin = [0.0, 1.0], size = [1.0, 1.0] }, \
+               { origin = [2.0, 0.0], size = [1.0, 0.5] } ]",
+            0.25,
+        );
+        let p = generate_particles(&s);
+        let keys: HashSet<(i64, i64)> = p
+            .position
+            .iter()
+            .map(|q| ((q[0] / 0.25).round() as i64, (q[1] / 0.25).round() as i64))
+            .collect();
+        assert_eq!(keys.len(), p.len(), "duplicate particles");
+        // base 9x5 + top 5x4 extra rows + right block 4x3 extra columns
+        assert_eq!(p.len(), 9 * 5 + 5 * 4 + 4 * 3);
+        for w in p.position.windows(2) {
+            assert!(w[0][1] < w[1][1] || (w[0][1] == w[1][1] && w[0][0] < w[1][0]));
+        }
+    }
+
+    #[test]
+    fn nearest_breaks_ties_by_smaller_gid() {
+        let s = scene_with("[ { origin = [0.0, 0.0], size = [1.0, 1.0] } ]", 0.5);
+        let p = generate_particles(&s);
+        // (0.25, 0.25) is equidistant from gids 0, 1, 3, 4.
+        assert_eq!(nearest(&p, [0.25, 0.25]).unwrap().0, 0);
+        assert_eq!(nearest(&p, [0.75, 0.75]).unwrap().0, 4);
+    }
+}

@@ -1,0 +1,268 @@
+//! The scene document: one struct per TOML table. Field documentation here is the reference for
+//! scene authors; every table rejects unknown keys so that a typo is an error, not a silently
+//! ignored setting. Units are SI throughout.
+
+use serde::{Deserialize, Serialize};
+
+use super::selector::Selector;
+
+/// A complete, validated problem description.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Short name shown in summaries and output.
+    pub name: String,
+    pub body: Body,
+    pub mesh: Mesh,
+    pub material: Material,
+    /// Defaults to no gravity.
+    #[serde(default)]
+    pub gravity: Gravity,
+    /// `[[fixed]]` entries: zero-displacement supports.
+    #[serde(default)]
+    pub fixed: Vec<Fixed>,
+    /// `[[point_load]]` entries: concentrated forces on tracked particles.
+    #[serde(default)]
+    pub point_load: Vec<PointLoad>,
+    /// `[[prescribed]]` entries: imposed displacements (footings, platens).
+    #[serde(default)]
+    pub prescribed: Vec<Prescribed>,
+    pub steps: Steps,
+    pub history: History,
+    #[serde(default)]
+    pub output: Output,
+    #[serde(default)]
+    pub solver: Solver,
+}
+
+/// `[body]`: the initial domain, a union of axis-aligned rectangles filled with a square
+/// particle lattice of spacing `mesh.h`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Body {
+    /// `rectangles = [ { origin = [x0, y0], size = [width, height] }, ... ]` (m). Every origin
+    /// offset (from the first rectangle's origin) and every size must be a whole number of
+    /// particle spacings, so that rectangle edges carry particles and adjacent rectangles share
+    /// them.
+    pub rectangles: Vec<Rectangle>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Rectangle {
+    /// Lower-left corner (m).
+    pub origin: [f64; 2],
+    /// Width and height (m), both > 0.
+    pub size: [f64; 2],
+}
+
+/// `[mesh]`: particle spacing and remeshing controls.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Mesh {
+    /// Particle spacing (m), > 0.
+    pub h: f64,
+    /// Alpha-shape parameter: a Delaunay triangle is kept when its circumradius is at most
+    /// `alpha * h`. Must be at least sqrt(2)/2, the circumradius ratio of the lattice's own
+    /// triangles. Default 1.3.
+    #[serde(default = "default_alpha")]
+    pub alpha: f64,
+    /// Insert/remove particles to keep the spacing near `h` (Fig. 4 of the method). Default true.
+    #[serde(default = "default_true")]
+    pub refine: bool,
+    /// Laplacian smoothing of interior particles after remeshing. Default false.
+    #[serde(default)]
+    pub smooth: bool,
+}
+
+fn default_alpha() -> f64 {
+    1.3
+}
+
+fn default_true() -> bool {
+    true
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MaterialModel {
+    /// `"linear-elastic"`: `young`, `poisson`.
+    LinearElastic,
+    /// `"tresca"`: elastic-perfectly plastic with undrained shear strength `cu`.
+    Tresca,
+}
+
+impl MaterialModel {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            MaterialModel::LinearElastic => "linear-elastic",
+            MaterialModel::Tresca => "tresca",
+        }
+    }
+}
+
+/// `[material]`: one material for the whole body.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// `"linear-elastic"` or `"tresca"`.
+    pub model: MaterialModel,
+    /// Young's modulus (Pa), > 0.
+    pub young: f64,
+    /// Poisson's ratio, -1 < poisson < 0.5.
+    pub poisson: f64,
+    /// Mass density (kg/m3), >= 0; the body force is `density * gravity.g`. Default 0.
+    #[serde(default)]
+    pub density: f64,
+    /// Undrained shear strength (Pa); required > 0 for `"tresca"`, ignored otherwise. Default 0.
+    #[serde(default)]
+    pub cu: f64,
+}
+
+/// `[gravity]`: gravitational acceleration vector (m/s2), e.g. `g = [0.0, -9.81]`.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Gravity {
+    #[serde(default)]
+    pub g: [f64; 2],
+}
+
+/// A displacement component.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Dof {
+    X,
+    Y,
+}
+
+impl Dof {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Dof::X => "x",
+            Dof::Y => "y",
+        }
+    }
+
+    /// Component index into `[ux, uy]`.
+    pub fn index(self) -> usize {
+        match self {
+            Dof::X => 0,
+            Dof::Y => 1,
+        }
+    }
+}
+
+/// `[[fixed]]`: zero displacement of `dofs` for every particle selected by `where`. The
+/// selection is geometric and is re-evaluated on every remesh.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fixed {
+    /// `where = "x <= 0"`: comparisons `x <= c`, `x >= c`, `y <= c`, `y >= c` joined by `and`;
+    /// boundaries are matched within 1e-9 times the body's largest dimension.
+    #[serde(rename = "where")]
+    pub region: Selector,
+    /// Constrained components, a non-empty subset of `["x", "y"]`.
+    pub dofs: Vec<Dof>,
+}
+
+/// `[[point_load]]`: a force applied to one tracked particle, scaled by the load factor.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLoad {
+    /// The tracked particle is the one nearest to this point when the case is created (ties go
+    /// to the smaller global id); it must lie within one spacing of the body.
+    pub at: [f64; 2],
+    /// Force (N per metre of thickness) at full load, load factor 1.
+    pub force: [f64; 2],
+}
+
+/// `[[prescribed]]`: imposed displacement of the particles selected by `where` in the initial
+/// configuration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Prescribed {
+    /// Same syntax as `fixed.where`, e.g. `"y >= 10 and x <= 1"`.
+    #[serde(rename = "where")]
+    pub region: Selector,
+    /// Prescribed components, a non-empty subset of `["x", "y"]`.
+    pub dofs: Vec<Dof>,
+    /// Displacement (m) reached at the end of loading, applied linearly over the steps. Only the
+    /// components listed in `dofs` are used.
+    pub total: [f64; 2],
+}
+
+/// `[steps]`: load stepping.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Steps {
+    /// Number of load steps, >= 1; the load factor goes from 0 to 1 in equal increments.
+    pub count: u32,
+}
+
+/// Which quantities `history.csv` records.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum HistoryKind {
+    /// Tip displacement of the first point load's tracked particle. Needs a `[[point_load]]`.
+    Cantilever,
+    /// Footing load against settlement. Needs a `[[prescribed]]`.
+    Footing,
+    /// Platen force against platen displacement. Needs a `[[prescribed]]`.
+    Block,
+}
+
+impl HistoryKind {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            HistoryKind::Cantilever => "cantilever",
+            HistoryKind::Footing => "footing",
+            HistoryKind::Block => "block",
+        }
+    }
+}
+
+/// `[history]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct History {
+    /// `"cantilever"`, `"footing"` or `"block"`.
+    pub kind: HistoryKind,
+}
+
+/// `[output]`: checkpointing.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Output {
+    /// Write a checkpoint every this many steps; 0 = only at the end. Default 0.
+    pub checkpoint_every: u32,
+    /// Number of most recent checkpoints kept on disk, >= 1. Default 3.
+    pub checkpoint_keep: u32,
+}
+
+impl Default for Output {
+    fn default() -> Self {
+        Output {
+            checkpoint_every: 0,
+            checkpoint_keep: 3,
+        }
+    }
+}
+
+/// `[solver]`: Newton-Raphson controls.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Solver {
+    /// Maximum Newton iterations per step, >= 1. Default 25.
+    pub newton_max_it: u32,
+    /// Relative residual tolerance, 0 < newton_rtol < 1. Default 1e-9.
+    pub newton_rtol: f64,
+}
+
+impl Default for Solver {
+    fn default() -> Self {
+        Solver {
+            newton_max_it: 25,
+            newton_rtol: 1e-9,
+        }
+    }
+}

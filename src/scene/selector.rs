@@ -1,0 +1,182 @@
+//! Geometric selections of particles: `where = "x <= 0"`, `where = "y >= 10 and x <= 1"`.
+//!
+//! A selector is a conjunction of axis comparisons, i.e. an axis-aligned (possibly unbounded)
+//! box. Points on the box boundary are selected within a tolerance so that lattice particles
+//! lying exactly on a plane like `x <= 0` are not lost to round-off.
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Axis {
+    X,
+    Y,
+}
+
+impl Axis {
+    /// Component index into a point `[x, y]`.
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Comparison {
+    /// `<=`
+    AtMost,
+    /// `>=`
+    AtLeast,
+}
+
+/// One term `axis op value` of a selector.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Condition {
+    pub axis: Axis,
+    pub comparison: Comparison,
+    pub value: f64,
+}
+
+impl Condition {
+    /// True when `p` satisfies the condition, with `tol` of slack on the boundary.
+    pub fn holds(&self, p: [f64; 2], tol: f64) -> bool {
+        let c = p[self.axis.index()];
+        match self.comparison {
+            Comparison::AtMost => c <= self.value + tol,
+            Comparison::AtLeast => c >= self.value - tol,
+        }
+    }
+}
+
+/// A conjunction of conditions; written in TOML as a string like `"y >= 10 and x <= 1"`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub struct Selector {
+    conditions: Vec<Condition>,
+}
+
+const SYNTAX_HELP: &str = "expected comparisons like \"x <= 1.5\" joined by \"and\" \
+                           (axis x or y, operator <= or >=, a finite number)";
+
+impl Selector {
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let mut conditions = Vec::new();
+        for term in text.split(" and ") {
+            conditions.push(parse_condition(term.trim()).ok_or_else(|| {
+                format!("cannot read \"{}\" in \"{text}\": {SYNTAX_HELP}", term.trim())
+            })?);
+        }
+        Ok(Selector { conditions })
+    }
+
+    pub fn conditions(&self) -> &[Condition] {
+        &self.conditions
+    }
+
+    /// True when `p` satisfies every condition (boundary slack `tol`).
+    pub fn matches(&self, p: [f64; 2], tol: f64) -> bool {
+        self.conditions.iter().all(|c| c.holds(p, tol))
+    }
+
+    /// The selected closed interval along `axis`, as `(lo, hi)` (infinite when unbounded).
+    pub fn interval(&self, axis: Axis) -> (f64, f64) {
+        let mut lo = f64::NEG_INFINITY;
+        let mut hi = f64::INFINITY;
+        for c in self.conditions.iter().filter(|c| c.axis == axis) {
+            match c.comparison {
+                Comparison::AtMost => hi = hi.min(c.value),
+                Comparison::AtLeast => lo = lo.max(c.value),
+            }
+        }
+        (lo, hi)
+    }
+}
+
+fn parse_condition(term: &str) -> Option<Condition> {
+    let mut chars = term.chars();
+    let axis = match chars.next()? {
+        'x' => Axis::X,
+        'y' => Axis::Y,
+        _ => return None,
+    };
+    let rest = chars.as_str().trim_start();
+    let (comparison, number) = if let Some(n) = rest.strip_prefix("<=") {
+        (Comparison::AtMost, n)
+    } else if let Some(n) = rest.strip_prefix(">=") {
+        (Comparison::AtLeast, n)
+    } else {
+        return None;
+    };
+    let value: f64 = number.trim().parse().ok()?;
+    value.is_finite().then_some(Condition {
+        axis,
+        comparison,
+        value,
+    })
+}
+
+impl TryFrom<String> for Selector {
+    type Error = String;
+
+    fn try_from(text: String) -> Result<Self, String> {
+        Selector::parse(&text)
+    }
+}
+
+impl From<Selector> for String {
+    fn from(s: Selector) -> String {
+        s.to_string()
+    }
+}
+
+impl fmt::Display for Selector {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, c) in self.conditions.iter().enumerate() {
+            if i > 0 {
+                write!(f, " and ")?;
+            }
+            let axis = match c.axis {
+                Axis::X => "x",
+                Axis::Y => "y",
+            };
+            let op = match c.comparison {
+                Comparison::AtMost => "<=",
+                Comparison::AtLeast => ">=",
+            };
+            write!(f, "{axis} {op} {}", c.value)?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_conjunctions_and_round_trips() {
+        let s = Selector::parse("y >= 10 and x<=1").unwrap();
+        assert_eq!(s.conditions().len(), 2);
+        assert_eq!(s.to_string(), "y >= 10 and x <= 1");
+        assert_eq!(Selector::parse(&s.to_string()).unwrap(), s);
+        assert_eq!(s.interval(Axis::Y), (10.0, f64::INFINITY));
+    }
+
+    #[test]
+    fn boundary_points_match_within_tolerance() {
+        let s = Selector::parse("x <= 0").unwrap();
+        assert!(s.matches([1e-12, 5.0], 1e-9));
+        assert!(!s.matches([1e-6, 5.0], 1e-9));
+    }
+
+    #[test]
+    fn rejects_bad_syntax_with_help() {
+        for bad in ["z <= 1", "x < 1", "x <= one", "x <= inf", "", "x <= 1 or y >= 2"] {
+            let e = Selector::parse(bad).unwrap_err();
+            assert!(e.contains("expected comparisons"), "{bad}: {e}");
+        }
+    }
+}

@@ -1,0 +1,256 @@
+//! Scene loading: built-ins, error messages naming their field, `--set` overrides.
+
+use super::*;
+
+const CANTILEVER: &str = include_str!("builtin/cantilever.toml");
+
+/// The cantilever scene file with `from` replaced by `to`, read as file `cantilever.toml`.
+fn edited(from: &str, to: &str) -> Result<Scene, SceneError> {
+    assert!(CANTILEVER.contains(from), "test edit target {from:?} not in the scene");
+    Scene::from_toml(&CANTILEVER.replacen(from, to, 1), "cantilever.toml", &[])
+}
+
+fn with_sets(sets: &[&str]) -> Result<Scene, SceneError> {
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    load_scene("cantilever", &sets).map(|(s, _)| s)
+}
+
+#[test]
+fn builtins_parse_validate_and_round_trip() {
+    for (name, _) in BUILTINS {
+        let (scene, resolved) = load_scene(name, &[]).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(&scene.name, name);
+        let again = Scene::from_toml(&resolved, name, &[]).unwrap();
+        assert_eq!(again, scene, "{name} does not round-trip through its resolved TOML");
+        assert_eq!(again.to_toml(), resolved);
+    }
+    let (footing, _) = load_scene("footing-shallow", &[]).unwrap();
+    assert_eq!(footing.material.model, MaterialModel::Tresca);
+    assert!(footing.material.cu > 0.0);
+    let (block, _) = load_scene("block-compression", &[]).unwrap();
+    assert_eq!(block.material.model, MaterialModel::Tresca);
+    assert_eq!(block.history.kind, HistoryKind::Block);
+}
+
+#[test]
+fn cantilever_values() {
+    let (s, _) = load_scene("cantilever", &[]).unwrap();
+    assert_eq!(s.mesh.h, 0.125);
+    assert_eq!(s.body.rectangles[0].size, [10.0, 1.0]);
+    assert_eq!(s.fixed[0].region.to_string(), "x <= 0");
+    assert_eq!(s.fixed[0].dofs, vec![Dof::X, Dof::Y]);
+    assert_eq!(s.point_load[0].at, [10.0, 0.5]);
+    assert_eq!(s.steps.count, 50);
+    assert_eq!(s.tolerance(), 1e-8);
+}
+
+#[test]
+fn bad_value_message_names_scene_and_field() {
+    let e = edited("h = 0.125", "h = -1").unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "scene 'cantilever.toml': field mesh.h: must be > 0 (got -1)"
+    );
+    assert_eq!(e.field.as_deref(), Some("mesh.h"));
+}
+
+#[test]
+fn unknown_key_is_named() {
+    let e = edited("alpha = 1.3", "alpah = 1.3").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("mesh.alpah"), "{e}");
+    assert!(e.to_string().contains("field mesh.alpah: unknown key"), "{e}");
+    assert!(e.message.contains("alpha"), "should list the valid keys: {e}");
+
+    let e = edited("[steps]", "[stepz]").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("stepz"), "{e}");
+
+    let e = edited("dofs = [\"x\", \"y\"]", "dofs = [\"x\", \"y\"]\nwehre = 1").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("fixed[0].wehre"), "{e}");
+
+    let e = edited("[{ origin", "[{ orgin").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("body.rectangles[0].orgin"), "{e}");
+}
+
+#[test]
+fn wrong_type_is_named() {
+    let e = edited("h = 0.125", "h = \"fine\"").unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "scene 'cantilever.toml': field mesh.h: expected a number, found string \"fine\""
+    );
+    let e = edited("count = 50", "count = 2.5").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("steps.count"), "{e}");
+    let e = edited("count = 50", "count = -3").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("steps.count"), "{e}");
+    let e = edited("refine = true", "refine = 1").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("mesh.refine"), "{e}");
+    let e = edited("model = \"linear-elastic\"", "model = \"elastic\"").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("material.model"), "{e}");
+    assert!(e.message.contains("\"linear-elastic\", \"tresca\""), "{e}");
+    let e = edited("kind = \"cantilever\"", "kind = 3").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("history.kind"), "{e}");
+    let e = edited("at = [10.0, 0.5]", "at = [10.0, 0.5, 0.0]").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("point_load[0].at"), "{e}");
+    let e = edited("at = [10.0, 0.5]", "at = [10.0]").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("point_load[0].at"), "{e}");
+    let e = edited("at = [10.0, 0.5]", "at = [10.0, \"top\"]").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("point_load[0].at[1]"), "{e}");
+    let e = edited("dofs = [\"x\", \"y\"]", "dofs = [\"x\", \"z\"]").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("fixed[0].dofs[1]"), "{e}");
+    let e = edited("[mesh]\nh = 0.125", "mesh = 3\n[mesh2]\nh = 0.125").unwrap_err();
+    assert!(e.field.is_some(), "{e}");
+}
+
+#[test]
+fn missing_key_is_named() {
+    let e = edited("young = 12.0e6\n", "").unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "scene 'cantilever.toml': field material.young: required key is missing"
+    );
+}
+
+#[test]
+fn bad_selector_is_named() {
+    let e = edited("where = \"x <= 0\"", "where = \"x < 0\"").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("fixed[0].where"), "{e}");
+    assert!(e.message.contains("expected comparisons"), "{e}");
+    let e = edited("where = \"x <= 0\"", "where = \"x <= -1\"").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("fixed[0].where"), "{e}");
+    assert!(e.message.contains("selects no particle"), "{e}");
+}
+
+#[test]
+fn validation_messages_name_fields() {
+    let cases = [
+        ("poisson = 0.2", "poisson = 0.5", "material.poisson", "must be > -1 and < 0.5 (got 0.5)"),
+        ("poisson = 0.2", "poisson = -1.0", "material.poisson", "(got -1)"),
+        ("young = 12.0e6", "young = 0.0", "material.young", "must be > 0 (got 0)"),
+        ("alpha = 1.3", "alpha = 0.0", "mesh.alpha", "must be > 0 (got 0)"),
+        ("alpha = 1.3", "alpha = 0.5", "mesh.alpha", "must be >= 0.7071"),
+        ("count = 50", "count = 0", "steps.count", "must be >= 1 (got 0)"),
+        ("density = 0.0", "density = -1.0", "material.density", "must be >= 0"),
+        ("checkpoint_keep = 3", "checkpoint_keep = 0", "output.checkpoint_keep", ">= 1"),
+        ("newton_rtol = 1e-9", "newton_rtol = 0.0", "solver.newton_rtol", "> 0 and < 1"),
+        ("newton_max_it = 25", "newton_max_it = 0", "solver.newton_max_it", ">= 1"),
+        ("g = [0.0, 0.0]", "g = [0.0, nan]", "gravity.g", "finite"),
+        ("name = \"cantilever\"", "name = \"\"", "name", "must not be empty"),
+        ("size = [10.0, 1.0]", "size = [10.0, -1.0]", "body.rectangles[0].size", "> 0"),
+        ("size = [10.0, 1.0]", "size = [10.05, 1.0]", "body.rectangles[0].size", "whole number"),
+        ("rectangles = [{ origin = [0.0, 0.0], size = [10.0, 1.0] }]", "rectangles = []",
+         "body.rectangles", "at least one"),
+        ("at = [10.0, 0.5]", "at = [12.0, 0.5]", "point_load[0].at", "within one particle spacing"),
+        ("dofs = [\"x\", \"y\"]", "dofs = []", "fixed[0].dofs", "at least one"),
+        ("dofs = [\"x\", \"y\"]", "dofs = [\"x\", \"x\"]", "fixed[0].dofs", "lists \"x\" twice"),
+        ("model = \"linear-elastic\"", "model = \"tresca\"", "material.cu",
+         "must be > 0 for model \"tresca\" (got 0)"),
+        ("kind = \"cantilever\"", "kind = \"footing\"", "history.kind", "no [[prescribed]]"),
+        ("h = 0.125", "h = 1e-6", "mesh.h", "more than the limit"),
+    ];
+    for (from, to, field, text) in cases {
+        let e = edited(from, to).expect_err(to);
+        assert_eq!(e.field.as_deref(), Some(field), "{to}: {e}");
+        assert!(e.message.contains(text), "{to}: {e}");
+        assert!(e.to_string().starts_with(&format!("scene 'cantilever.toml': field {field}: ")));
+    }
+}
+
+#[test]
+fn toml_syntax_error_gives_line() {
+    let e = edited("h = 0.125", "h = = 0.125").unwrap_err();
+    assert!(e.message.starts_with("invalid TOML at line 9, column 5: "), "{e}");
+    assert!(!e.message.contains('\n'), "{e}");
+    assert!(e.field.is_none());
+}
+
+#[test]
+fn set_overrides_values() {
+    let s = with_sets(&["mesh.h=0.25", "steps.count=20"]).unwrap();
+    assert_eq!(s.mesh.h, 0.25);
+    assert_eq!(s.steps.count, 20);
+    let s = with_sets(&["mesh.h=0.25", "mesh.h=0.5"]).unwrap();
+    assert_eq!(s.mesh.h, 0.5, "the last --set wins");
+    let s = with_sets(&[
+        "material.model=tresca",
+        "material.cu=50e3",
+        "gravity.g=[0.0, -9.81]",
+        "point_load[0].force=[0.0, -5.0e4]",
+        "fixed[0].dofs=[\"x\"]",
+        "mesh.h=1",
+    ])
+    .unwrap();
+    assert_eq!(s.material.model, MaterialModel::Tresca);
+    assert_eq!(s.material.cu, 50e3);
+    assert_eq!(s.gravity.g, [0.0, -9.81]);
+    assert_eq!(s.point_load[0].force, [0.0, -5.0e4]);
+    assert_eq!(s.fixed[0].dofs, vec![Dof::X]);
+    assert_eq!(s.mesh.h, 1.0, "an integer is accepted for a number");
+}
+
+#[test]
+fn set_defaults_that_the_file_omits() {
+    // The footing scene has no [output] keys beyond the defaults' names; --set must reach
+    // tables and keys that are absent from the text.
+    let text = CANTILEVER.replace("[solver]\nnewton_max_it = 25\nnewton_rtol = 1e-9\n", "");
+    let sets = vec!["solver.newton_max_it=40".to_string()];
+    let s = Scene::from_toml(&text, "cantilever.toml", &sets).unwrap();
+    assert_eq!(s.solver.newton_max_it, 40);
+    assert_eq!(s.solver.newton_rtol, 1e-9);
+}
+
+#[test]
+fn set_errors_name_the_path() {
+    let e = with_sets(&["mesh.hh=0.2"]).unwrap_err();
+    assert_eq!(e.set.as_deref(), Some("mesh.hh=0.2"));
+    assert_eq!(e.field.as_deref(), Some("mesh.hh"));
+    assert!(e.to_string().starts_with("scene 'cantilever': --set mesh.hh=0.2: field mesh.hh: no such key"), "{e}");
+
+    let e = with_sets(&["mseh.h=0.2"]).unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("mseh"), "{e}");
+    assert_eq!(e.set.as_deref(), Some("mseh.h=0.2"));
+
+    let e = with_sets(&["point_load[3].force=[0.0, 1.0]"]).unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("point_load[3]"), "{e}");
+
+    let e = with_sets(&["mesh.h.x=1"]).unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("mesh.h"), "{e}");
+    assert!(e.message.contains("not a table"), "{e}");
+
+    let e = with_sets(&["steps.count=abc"]).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "scene 'cantilever': --set steps.count=abc: field steps.count: \
+         expected a whole number >= 0, found string \"abc\""
+    );
+
+    let e = with_sets(&["mesh.h=-1"]).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "scene 'cantilever': --set mesh.h=-1: field mesh.h: must be > 0 (got -1)"
+    );
+
+    let e = with_sets(&["mesh.h"]).unwrap_err();
+    assert_eq!(e.set.as_deref(), Some("mesh.h"));
+    assert!(e.message.contains("KEY=VALUE"), "{e}");
+
+    let e = with_sets(&["mesh.h=0.1.2"]).unwrap_err();
+    assert!(e.message.contains("cannot read value"), "{e}");
+}
+
+#[test]
+fn load_scene_by_path_and_unknown_name() {
+    let e = load_scene("cantileverr", &[]).unwrap_err();
+    assert!(e.message.contains("cantilever, footing-shallow, block-compression"), "{e}");
+    let e = load_scene("/nonexistent/dir/scene.toml", &[]).unwrap_err();
+    assert!(e.to_string().starts_with("scene '/nonexistent/dir/scene.toml': cannot read"), "{e}");
+
+    let dir = std::env::temp_dir().join(format!("pfem-scene-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("beam.toml");
+    std::fs::write(&path, CANTILEVER.replace("name = \"cantilever\"", "name = \"beam\"")).unwrap();
+    let (s, resolved) = load_scene(path.to_str().unwrap(), &["steps.count=7".to_string()]).unwrap();
+    assert_eq!(s.name, "beam");
+    assert_eq!(s.steps.count, 7);
+    assert!(resolved.contains("count = 7"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,0 +1,289 @@
+//! Physical and geometric sanity of a deserialized scene. Each failure names the field at fault
+//! and the offending value, so that a user can fix the scene file without reading code.
+
+use std::collections::HashSet;
+
+use super::field_path::FieldPath;
+use super::lattice::{self, generate_particles};
+use super::schema::{Dof, HistoryKind, MaterialModel, Scene};
+use super::selector::Selector;
+
+/// Upper bound on the initial particle count, so that a mistyped `mesh.h` is reported instead
+/// of exhausting memory.
+pub const MAX_PARTICLES: u64 = 1_000_000_000;
+
+pub type Invalid = (FieldPath, String);
+
+fn fail<T>(path: FieldPath, message: String) -> Result<T, Invalid> {
+    Err((path, message))
+}
+
+fn vec2(v: [f64; 2]) -> String {
+    format!("[{}, {}]", v[0], v[1])
+}
+
+fn finite2(path: FieldPath, v: [f64; 2]) -> Result<(), Invalid> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        fail(path, format!("must be finite (got {})", vec2(v)))
+    }
+}
+
+fn positive(path: FieldPath, x: f64) -> Result<(), Invalid> {
+    if x > 0.0 && x.is_finite() {
+        Ok(())
+    } else {
+        fail(path, format!("must be > 0 (got {x})"))
+    }
+}
+
+fn non_negative(path: FieldPath, x: f64) -> Result<(), Invalid> {
+    if x >= 0.0 && x.is_finite() {
+        Ok(())
+    } else {
+        fail(path, format!("must be >= 0 (got {x})"))
+    }
+}
+
+fn dofs(path: FieldPath, dofs: &[Dof]) -> Result<(), Invalid> {
+    if dofs.is_empty() {
+        return fail(path, "must list at least one of \"x\", \"y\"".to_string());
+    }
+    let mut seen = HashSet::new();
+    for d in dofs {
+        if !seen.insert(d) {
+            return fail(path, format!("lists \"{}\" twice", d.as_str()));
+        }
+    }
+    Ok(())
+}
+
+/// Checks everything that can be checked without generating particles.
+fn check_fields(s: &Scene) -> Result<(), Invalid> {
+    let root = FieldPath::default();
+    if s.name.trim().is_empty() {
+        return fail(root.join("name"), "must not be empty".to_string());
+    }
+
+    let rects = root.join("body").join("rectangles");
+    if s.body.rectangles.is_empty() {
+        return fail(rects, "must contain at least one rectangle".to_string());
+    }
+    for (i, r) in s.body.rectangles.iter().enumerate() {
+        finite2(rects.at(i).join("origin"), r.origin)?;
+        if !(r.size[0] > 0.0 && r.size[1] > 0.0 && r.size.iter().all(|x| x.is_finite())) {
+            return fail(
+                rects.at(i).join("size"),
+                format!("must be > 0 in both components (got {})", vec2(r.size)),
+            );
+        }
+    }
+
+    let mesh = root.join("mesh");
+    positive(mesh.join("h"), s.mesh.h)?;
+    positive(mesh.join("alpha"), s.mesh.alpha)?;
+    if s.mesh.alpha < std::f64::consts::FRAC_1_SQRT_2 {
+        return fail(
+            mesh.join("alpha"),
+            format!(
+                "must be >= 0.7071 (got {}): smaller values delete every triangle of the \
+                 square particle lattice",
+                s.mesh.alpha
+            ),
+        );
+    }
+
+    let mat = root.join("material");
+    positive(mat.join("young"), s.material.young)?;
+    let nu = s.material.poisson;
+    if !(nu > -1.0 && nu < 0.5) {
+        return fail(
+            mat.join("poisson"),
+            format!("must be > -1 and < 0.5 (got {nu})"),
+        );
+    }
+    non_negative(mat.join("density"), s.material.density)?;
+    match s.material.model {
+        MaterialModel::Tresca => {
+            if !(s.material.cu > 0.0 && s.material.cu.is_finite()) {
+                return fail(
+                    mat.join("cu"),
+                    format!("must be > 0 for model \"tresca\" (got {})", s.material.cu),
+                );
+            }
+        }
+        MaterialModel::LinearElastic => non_negative(mat.join("cu"), s.material.cu)?,
+    }
+
+    finite2(root.join("gravity").join("g"), s.gravity.g)?;
+
+    for (i, f) in s.fixed.iter().enumerate() {
+        dofs(root.join("fixed").at(i).join("dofs"), &f.dofs)?;
+    }
+    for (i, p) in s.point_load.iter().enumerate() {
+        let path = root.join("point_load").at(i);
+        finite2(path.join("at"), p.at)?;
+        finite2(path.join("force"), p.force)?;
+    }
+    for (i, p) in s.prescribed.iter().enumerate() {
+        let path = root.join("prescribed").at(i);
+        dofs(path.join("dofs"), &p.dofs)?;
+        finite2(path.join("total"), p.total)?;
+    }
+
+    if s.steps.count < 1 {
+        return fail(
+            root.join("steps").join("count"),
+            format!("must be >= 1 (got {})", s.steps.count),
+        );
+    }
+
+    let kind = root.join("history").join("kind");
+    match s.history.kind {
+        HistoryKind::Cantilever if s.point_load.is_empty() => {
+            return fail(
+                kind,
+                "\"cantilever\" records the displacement of the first [[point_load]]'s \
+                 particle, but the scene has no [[point_load]]"
+                    .to_string(),
+            );
+        }
+        HistoryKind::Footing | HistoryKind::Block if s.prescribed.is_empty() => {
+            return fail(
+                kind,
+                format!(
+                    "\"{}\" records the force on the [[prescribed]] particles, but the scene \
+                     has no [[prescribed]]",
+                    s.history.kind.as_str()
+                ),
+            );
+        }
+        _ => {}
+    }
+
+    if s.output.checkpoint_keep < 1 {
+        return fail(
+            root.join("output").join("checkpoint_keep"),
+            format!("must be >= 1 (got {})", s.output.checkpoint_keep),
+        );
+    }
+    let solver = root.join("solver");
+    if s.solver.newton_max_it < 1 {
+        return fail(
+            solver.join("newton_max_it"),
+            format!("must be >= 1 (got {})", s.solver.newton_max_it),
+        );
+    }
+    let rtol = s.solver.newton_rtol;
+    if !(rtol > 0.0 && rtol < 1.0) {
+        return fail(
+            solver.join("newton_rtol"),
+            format!("must be > 0 and < 1 (got {rtol})"),
+        );
+    }
+    Ok(())
+}
+
+/// Rectangle corners must sit on the lattice so that edges carry particles.
+fn check_alignment(s: &Scene) -> Result<(), Invalid> {
+    let h = s.mesh.h;
+    let anchor = s.body.rectangles[0].origin;
+    let rects = FieldPath::key("body").join("rectangles");
+    for (i, r) in s.body.rectangles.iter().enumerate() {
+        for axis in 0..2 {
+            let offset = (r.origin[axis] - anchor[axis]) / h;
+            if lattice::whole(offset).is_none() {
+                return fail(
+                    rects.at(i).join("origin"),
+                    format!(
+                        "{} is {offset:.4} particle spacings (mesh.h = {h}) from the first \
+                         rectangle's origin; it must be a whole number",
+                        vec2(r.origin)
+                    ),
+                );
+            }
+            let count = r.size[axis] / h;
+            if lattice::whole(count).is_none() {
+                return fail(
+                    rects.at(i).join("size"),
+                    format!(
+                        "{} is {count:.4} particle spacings (mesh.h = {h}) along {}; it must \
+                         be a whole number",
+                        r.size[axis],
+                        ["x", "y"][axis]
+                    ),
+                );
+            }
+        }
+    }
+    let upper: f64 = s
+        .body
+        .rectangles
+        .iter()
+        .map(|r| (r.size[0] / h + 1.0) * (r.size[1] / h + 1.0))
+        .sum();
+    if upper > MAX_PARTICLES as f64 {
+        return fail(
+            FieldPath::key("mesh").join("h"),
+            format!(
+                "h = {h} would create about {upper:.3e} particles, more than the limit of \
+                 {MAX_PARTICLES}"
+            ),
+        );
+    }
+    Ok(())
+}
+
+fn check_selects_something(
+    path: FieldPath,
+    region: &Selector,
+    positions: &[[f64; 2]],
+    tol: f64,
+) -> Result<(), Invalid> {
+    if positions.iter().any(|&p| region.matches(p, tol)) {
+        Ok(())
+    } else {
+        fail(
+            path,
+            format!("\"{region}\" selects no particle of the body"),
+        )
+    }
+}
+
+/// Checks that depend on the generated lattice: selections must select something and point
+/// loads must sit on the body.
+fn check_against_particles(s: &Scene) -> Result<(), Invalid> {
+    let particles = generate_particles(s);
+    let tol = s.tolerance();
+    for (i, f) in s.fixed.iter().enumerate() {
+        let path = FieldPath::key("fixed").at(i).join("where");
+        check_selects_something(path, &f.region, &particles.position, tol)?;
+    }
+    for (i, p) in s.prescribed.iter().enumerate() {
+        let path = FieldPath::key("prescribed").at(i).join("where");
+        check_selects_something(path, &p.region, &particles.position, tol)?;
+    }
+    for (i, p) in s.point_load.iter().enumerate() {
+        if let Some((_, dist)) = lattice::nearest(&particles, p.at) {
+            if dist > s.mesh.h * (1.0 + 1e-9) {
+                return fail(
+                    FieldPath::key("point_load").at(i).join("at"),
+                    format!(
+                        "{} is {dist:.4} m from the nearest particle; it must lie within one \
+                         particle spacing ({}) of the body",
+                        vec2(p.at),
+                        s.mesh.h
+                    ),
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+pub fn validate(s: &Scene) -> Result<(), Invalid> {
+    check_fields(s)?;
+    check_alignment(s)?;
+    check_against_particles(s)
+}

@@ -1,0 +1,178 @@
+//! Global degree-of-freedom numbering of the P2 mesh across ranks. Vertex nodes are particles and
+//! belong to the particle's owner; edge (midside) nodes belong to the owner of their smaller-gid
+//! endpoint, which always holds every triangle around that edge. Owned dofs are numbered
+//! contiguously per rank (offsets by exclusive scan); ghost numbers are fetched from their owners.
+
+use crate::mesh::LocalMesh;
+use pfem_partition::{exscan_u64, fetch_pairs, Comm, PartitionError};
+use std::collections::HashMap;
+
+/// Key of a node for the by-id exchange: `[gid, NO_GID]` for a vertex, `[gid_a, gid_b]` for an edge.
+const NO_GID: u64 = u64::MAX;
+
+#[derive(Debug, Clone)]
+pub struct DofMap {
+    /// Local nodes: vertex nodes for local points used by a triangle, then edge nodes.
+    /// `node_of_point[p]` is the node of local point p, or `u32::MAX` when unused.
+    pub node_of_point: Vec<u32>,
+    /// Edge nodes as local point pairs, smaller gid first.
+    pub edges: Vec<[u32; 2]>,
+    /// Per triangle: its 6 nodes (3 vertices CCW, then edges 01, 12, 20).
+    pub tri_nodes: Vec<[u32; 6]>,
+    /// Global dof of each node's x component (y is +1).
+    pub node_global: Vec<usize>,
+    /// Whether this rank owns the node (and so its two rows).
+    pub node_owned: Vec<bool>,
+    /// Local point behind each vertex node (`u32::MAX` for edge nodes).
+    pub node_point: Vec<u32>,
+    pub n_owned_dofs: usize,
+    pub first_dof: usize,
+    pub n_global_dofs: usize,
+}
+
+impl DofMap {
+    /// Collective. Numbers the dofs of `mesh`.
+    pub fn build(comm: &Comm, mesh: &LocalMesh) -> Result<DofMap, PartitionError> {
+        let np = mesh.points.len();
+        let mut used = vec![false; np];
+        for t in &mesh.tris {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+        let mut node_of_point = vec![u32::MAX; np];
+        let mut node_point = Vec::new();
+        let mut node_owned = Vec::new();
+        let mut keys: Vec<[u64; 2]> = Vec::new();
+        for p in 0..np {
+            if used[p] {
+                node_of_point[p] = node_point.len() as u32;
+                node_point.push(p as u32);
+                node_owned.push(p < mesh.n_owned);
+                keys.push([mesh.gids[p], NO_GID]);
+            }
+        }
+        let mut edge_index: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut edges: Vec<[u32; 2]> = Vec::new();
+        let mut tri_nodes = Vec::with_capacity(mesh.tris.len());
+        for t in &mesh.tris {
+            let mut nodes = [0u32; 6];
+            for k in 0..3 {
+                nodes[k] = node_of_point[t[k] as usize];
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let e = if mesh.gids[a as usize] < mesh.gids[b as usize] { (a, b) } else { (b, a) };
+                let next = edges.len() as u32;
+                let idx = *edge_index.entry(e).or_insert_with(|| {
+                    edges.push([e.0, e.1]);
+                    next
+                });
+                nodes[3 + k] = idx; // edge index for now, turned into a node below
+            }
+            tri_nodes.push(nodes);
+        }
+        // Edge nodes follow the vertex nodes, in key order so the numbering is reproducible.
+        let mut order: Vec<u32> = (0..edges.len() as u32).collect();
+        order.sort_by_key(|&e| {
+            let [a, b] = edges[e as usize];
+            (mesh.gids[a as usize], mesh.gids[b as usize])
+        });
+        let n_vertex_nodes = node_point.len() as u32;
+        let mut node_of_edge = vec![0u32; edges.len()];
+        let mut sorted_edges = Vec::with_capacity(edges.len());
+        for (rank_in_order, &e) in order.iter().enumerate() {
+            node_of_edge[e as usize] = n_vertex_nodes + rank_in_order as u32;
+            let [a, b] = edges[e as usize];
+            sorted_edges.push([a, b]);
+            node_point.push(u32::MAX);
+            node_owned.push((a as usize) < mesh.n_owned);
+            keys.push([mesh.gids[a as usize], mesh.gids[b as usize]]);
+        }
+        for nodes in &mut tri_nodes {
+            for n in nodes.iter_mut().skip(3) {
+                *n = node_of_edge[*n as usize];
+            }
+        }
+        let n_owned_nodes = node_owned.iter().filter(|&&o| o).count();
+        let (first_node, n_global_nodes) = exscan_u64(comm, n_owned_nodes as u64);
+        let mut node_global = vec![usize::MAX; node_owned.len()];
+        let mut owned_number: HashMap<[u64; 2], u64> = HashMap::with_capacity(n_owned_nodes);
+        let mut next = first_node;
+        for (n, &own) in node_owned.iter().enumerate() {
+            if own {
+                node_global[n] = 2 * next as usize;
+                owned_number.insert(keys[n], 2 * next);
+                next += 1;
+            }
+        }
+        let mut requests = Vec::new();
+        let mut asked = Vec::new();
+        for (n, &own) in node_owned.iter().enumerate() {
+            if !own {
+                let owner_point = if node_point[n] != u32::MAX { node_point[n] } else { sorted_edges[n - n_vertex_nodes as usize][0] };
+                requests.push((mesh.owner[owner_point as usize], keys[n]));
+                asked.push(n);
+            }
+        }
+        let answers = fetch_pairs(comm, &requests, |k| {
+            owned_number.get(k).copied().ok_or_else(|| {
+                PartitionError::InvalidInput(format!(
+                    "node {:?} asked for by another rank is not on its owner: the halo is too narrow",
+                    k
+                ))
+            })
+        })?;
+        for (n, g) in asked.into_iter().zip(answers) {
+            node_global[n] = g as usize;
+        }
+        Ok(DofMap {
+            node_of_point,
+            edges: sorted_edges,
+            tri_nodes,
+            node_global,
+            node_owned,
+            node_point,
+            n_owned_dofs: 2 * n_owned_nodes,
+            first_dof: 2 * first_node as usize,
+            n_global_dofs: 2 * n_global_nodes as usize,
+        })
+    }
+
+    pub fn n_nodes(&self) -> usize {
+        self.node_global.len()
+    }
+
+    /// Global indices of the local vector (2 per node, node order): what the scatter gathers.
+    pub fn local_to_global(&self) -> Vec<usize> {
+        self.node_global.iter().flat_map(|&g| [g, g + 1]).collect()
+    }
+
+    /// Exact nonzero counts per owned row in the diagonal and off-diagonal blocks, from the mesh
+    /// graph: every triangle around an owned node is on this rank.
+    pub fn preallocation(&self) -> (Vec<i32>, Vec<i32>) {
+        let mut cols: Vec<Vec<u32>> = vec![Vec::new(); self.n_nodes()];
+        for nodes in &self.tri_nodes {
+            for &r in nodes {
+                if self.node_owned[r as usize] {
+                    cols[r as usize].extend_from_slice(nodes);
+                }
+            }
+        }
+        let mut d = vec![0i32; self.n_owned_dofs];
+        let mut o = vec![0i32; self.n_owned_dofs];
+        for (r, c) in cols.iter_mut().enumerate() {
+            if !self.node_owned[r] {
+                continue;
+            }
+            c.sort_unstable();
+            c.dedup();
+            let nd = c.iter().filter(|&&n| self.node_owned[n as usize]).count() as i32;
+            let no = c.len() as i32 - nd;
+            let row = self.node_global[r] - self.first_dof;
+            for k in 0..2 {
+                d[row + k] = 2 * nd;
+                o[row + k] = 2 * no;
+            }
+        }
+        (d, o)
+    }
+}

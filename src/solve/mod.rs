@@ -1,0 +1,10 @@
+//! One implicit load step on the distributed mesh: dof numbering, constraints and the Newton
+//! problem handed to PETSc's SNES.
+
+pub mod constraints;
+pub mod dofs;
+pub mod problem;
+
+pub use constraints::Constraints;
+pub use dofs::DofMap;
+pub use problem::{StepProblem, StepSetup};
