@@ -111,7 +111,8 @@ const HDF5_SIGNATURE: [u8; 8] = [0x89, b'H', b'D', b'F', b'\r', b'\n', 0x1a, b'\
 /// Checks that `path` is a readable HDF5 file before handing it to the library. The signature
 /// is at offset 0 or, after a user block, at 512, 1024, 2048, ...
 fn sniff(path: &Path) -> Result<(), CaseError> {
-    let io = |e: std::io::Error| CaseError::new(path, CaseErrorKind::Io, format!("cannot read: {e}"));
+    let io =
+        |e: std::io::Error| CaseError::new(path, CaseErrorKind::Io, format!("cannot read: {e}"));
     let mut f = std::fs::File::open(path).map_err(io)?;
     let len = f.metadata().map_err(io)?.len();
     let mut offset = 0u64;
@@ -124,13 +125,21 @@ fn sniff(path: &Path) -> Result<(), CaseError> {
         }
         offset = if offset == 0 { 512 } else { offset * 2 };
     }
-    Err(CaseError::new(path, CaseErrorKind::NotHdf5, "not an HDF5 file"))
+    Err(CaseError::new(
+        path,
+        CaseErrorKind::NotHdf5,
+        "not an HDF5 file",
+    ))
 }
 
 fn open_error(path: &Path, e: hdf5::Error) -> CaseError {
     let text = e.to_string();
     if text.contains("truncated") {
-        CaseError::new(path, CaseErrorKind::Malformed, format!("truncated file ({text})"))
+        CaseError::new(
+            path,
+            CaseErrorKind::Malformed,
+            format!("truncated file ({text})"),
+        )
     } else {
         CaseError::new(path, CaseErrorKind::Io, format!("cannot open: {text}"))
     }
@@ -171,7 +180,12 @@ fn write_column<T: H5Type>(
 }
 
 /// Reads rows `rows` of `ds` into `out` (collective).
-fn read_column<T: H5Type>(ds: &Dataset, width: usize, rows: Range<usize>, out: &mut [T]) -> hdf5::Result<()> {
+fn read_column<T: H5Type>(
+    ds: &Dataset,
+    width: usize,
+    rows: Range<usize>,
+    out: &mut [T],
+) -> hdf5::Result<()> {
     let space = ds.space()?;
     let selected = if width == 0 {
         space.select(rows)?
@@ -193,8 +207,20 @@ fn write_contents(
     let group = file.create_group(datasets::GROUP)?;
     let [gid, position, displacement, h, state, flags] = datasets::columns();
     write_column(&group, &gid, n, rows.clone(), &local.gid)?;
-    write_column(&group, &position, n, rows.clone(), local.position.as_flattened())?;
-    write_column(&group, &displacement, n, rows.clone(), local.displacement.as_flattened())?;
+    write_column(
+        &group,
+        &position,
+        n,
+        rows.clone(),
+        local.position.as_flattened(),
+    )?;
+    write_column(
+        &group,
+        &displacement,
+        n,
+        rows.clone(),
+        local.displacement.as_flattened(),
+    )?;
     write_column(&group, &h, n, rows.clone(), &local.h)?;
     write_column(&group, &state, n, rows.clone(), local.state.as_flattened())?;
     write_column(&group, &flags, n, rows, &local.flags)
@@ -217,7 +243,11 @@ pub fn write_case(
 
     let count = local.len() as u64;
     let mut inclusive = 0u64;
-    comm.scan_into(&count, &mut inclusive, mpi::collective::SystemOperation::sum());
+    comm.scan_into(
+        &count,
+        &mut inclusive,
+        mpi::collective::SystemOperation::sum(),
+    );
     let mut total = 0u64;
     comm.all_reduce_into(&count, &mut total, mpi::collective::SystemOperation::sum());
     let start = (inclusive - count) as usize;
@@ -225,14 +255,22 @@ pub fn write_case(
 
     let tmp = tmp_path(path);
     let created = mpio_file(comm, &tmp, true).map_err(|e| {
-        CaseError::new(path, CaseErrorKind::Io, format!("cannot create {}: {e}", tmp.display()))
+        CaseError::new(
+            path,
+            CaseErrorKind::Io,
+            format!("cannot create {}: {e}", tmp.display()),
+        )
     });
     let file = agree(comm, path, created)?;
     let ranks = comm.size() as u32;
     let written = write_contents(&file, header, ranks, local, rows, total as usize);
     let closed = file.close();
     let outcome = written.and(closed).map_err(|e| {
-        CaseError::new(path, CaseErrorKind::Io, format!("cannot write {}: {e}", tmp.display()))
+        CaseError::new(
+            path,
+            CaseErrorKind::Io,
+            format!("cannot write {}: {e}", tmp.display()),
+        )
     });
     if let Err(e) = agree(comm, path, outcome) {
         if comm.rank() == 0 {
@@ -244,7 +282,11 @@ pub fn write_case(
 
     let renamed = if comm.rank() == 0 {
         std::fs::rename(&tmp, path).map_err(|e| {
-            CaseError::new(path, CaseErrorKind::Io, format!("cannot rename {} to it: {e}", tmp.display()))
+            CaseError::new(
+                path,
+                CaseErrorKind::Io,
+                format!("cannot rename {} to it: {e}", tmp.display()),
+            )
         })
     } else {
         Ok(())
@@ -273,13 +315,34 @@ fn read_contents(
     let [gid, position, displacement, h, state, flags] = datasets::columns();
     let read = (|| {
         read_column(&ds[0], gid.width, rows.clone(), &mut p.gid)?;
-        read_column(&ds[1], position.width, rows.clone(), p.position.as_flattened_mut())?;
-        read_column(&ds[2], displacement.width, rows.clone(), p.displacement.as_flattened_mut())?;
+        read_column(
+            &ds[1],
+            position.width,
+            rows.clone(),
+            p.position.as_flattened_mut(),
+        )?;
+        read_column(
+            &ds[2],
+            displacement.width,
+            rows.clone(),
+            p.displacement.as_flattened_mut(),
+        )?;
         read_column(&ds[3], h.width, rows.clone(), &mut p.h)?;
-        read_column(&ds[4], state.width, rows.clone(), p.state.as_flattened_mut())?;
+        read_column(
+            &ds[4],
+            state.width,
+            rows.clone(),
+            p.state.as_flattened_mut(),
+        )?;
         read_column(&ds[5], flags.width, rows, &mut p.flags)
     })()
-    .map_err(|e| CaseError::new(path, CaseErrorKind::Malformed, format!("cannot read particles: {e}")));
+    .map_err(|e| {
+        CaseError::new(
+            path,
+            CaseErrorKind::Malformed,
+            format!("cannot read particles: {e}"),
+        )
+    });
     agree(comm, path, read)?;
     Ok((header, p))
 }
@@ -358,7 +421,10 @@ mod tests {
         std::fs::write(&text, b"just some text, long enough to be read").unwrap();
         let e = sniff(&text).unwrap_err();
         assert_eq!(e.kind, CaseErrorKind::NotHdf5);
-        assert_eq!(e.to_string(), format!("{}: not an HDF5 file", text.display()));
+        assert_eq!(
+            e.to_string(),
+            format!("{}: not an HDF5 file", text.display())
+        );
         let e = summarize(&text).unwrap_err();
         assert_eq!(e.kind, CaseErrorKind::NotHdf5);
         let e = summarize(&dir.join("absent.h5")).unwrap_err();
@@ -369,6 +435,9 @@ mod tests {
 
     #[test]
     fn tmp_path_appends_suffix() {
-        assert_eq!(tmp_path(Path::new("out/case.h5")), PathBuf::from("out/case.h5.tmp"));
+        assert_eq!(
+            tmp_path(Path::new("out/case.h5")),
+            PathBuf::from("out/case.h5.tmp")
+        );
     }
 }

@@ -29,6 +29,22 @@ impl TriStates {
         self.keys.binary_search(key).ok().map(|i| &self.states[i])
     }
 
+    /// Drops the triangles with a vertex in `moved` (their Gauss points are no longer where the
+    /// states were computed).
+    pub fn forget_touching(&mut self, moved: &std::collections::HashSet<u64>) {
+        let keep: Vec<bool> = self.keys.iter().map(|k| !k.iter().any(|g| moved.contains(g))).collect();
+        let mut i = 0;
+        self.keys.retain(|_| {
+            i += 1;
+            keep[i - 1]
+        });
+        let mut j = 0;
+        self.states.retain(|_| {
+            j += 1;
+            keep[j - 1]
+        });
+    }
+
     pub fn states(&self) -> &[[GaussState; 3]] {
         &self.states
     }

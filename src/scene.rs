@@ -116,11 +116,12 @@ impl Scene {
                 set: Some(raw.clone()),
                 ..SceneError::new(source, message)
             })?;
-            set.apply(&mut table).map_err(|(path, message)| SceneError {
-                set: Some(raw.clone()),
-                field: Some(path.to_string()),
-                ..SceneError::new(source, message)
-            })?;
+            set.apply(&mut table)
+                .map_err(|(path, message)| SceneError {
+                    set: Some(raw.clone()),
+                    field: Some(path.to_string()),
+                    ..SceneError::new(source, message)
+                })?;
             parsed.push(set);
         }
 
@@ -129,7 +130,8 @@ impl Scene {
             let set = responsible_set(&parsed, &e.path);
             let message = match (e.kind, set) {
                 (DeErrorKind::UnknownKey, Some(_)) => {
-                    format!("no such key in the scene schema ({})", e.message)
+                    e.message
+                        .replacen("unknown key", "no such key in the scene schema", 1)
                 }
                 _ => e.message,
             };

@@ -74,7 +74,10 @@ pub fn open_all(file: &File, path: &Path) -> Result<(Vec<Dataset>, u64), CaseErr
             .and_then(|t| t.to_descriptor())
             .map_err(|e| bad(c.name, format!("unreadable type: {e}")))?;
         if found != c.dtype {
-            return Err(bad(c.name, format!("expected type {}, found {found}", c.dtype)));
+            return Err(bad(
+                c.name,
+                format!("expected type {}, found {found}", c.dtype),
+            ));
         }
         let shape = ds.shape();
         let ok = if c.width == 0 {

@@ -13,7 +13,11 @@ enum Buffer<'a, T> {
     Target(&'a mut [T]),
 }
 
-fn transfer<T: H5Type>(ds: &Dataset, file_space: &Dataspace, buf: Buffer<'_, T>) -> hdf5::Result<()> {
+fn transfer<T: H5Type>(
+    ds: &Dataset,
+    file_space: &Dataspace,
+    buf: Buffer<'_, T>,
+) -> hdf5::Result<()> {
     let len = match &buf {
         Buffer::Source(b) => b.len(),
         Buffer::Target(b) => b.len(),
@@ -58,11 +62,19 @@ fn transfer<T: H5Type>(ds: &Dataset, file_space: &Dataspace, buf: Buffer<'_, T>)
 
 /// Collective write of `data` into the elements of `ds` selected by `file_space`. Every rank of
 /// the file's communicator must call it, with an empty selection if it has nothing to write.
-pub fn write_collective<T: H5Type>(ds: &Dataset, file_space: &Dataspace, data: &[T]) -> hdf5::Result<()> {
+pub fn write_collective<T: H5Type>(
+    ds: &Dataset,
+    file_space: &Dataspace,
+    data: &[T],
+) -> hdf5::Result<()> {
     transfer(ds, file_space, Buffer::Source(data))
 }
 
 /// Collective read of the elements of `ds` selected by `file_space` into `data`.
-pub fn read_collective<T: H5Type>(ds: &Dataset, file_space: &Dataspace, data: &mut [T]) -> hdf5::Result<()> {
+pub fn read_collective<T: H5Type>(
+    ds: &Dataset,
+    file_space: &Dataspace,
+    data: &mut [T],
+) -> hdf5::Result<()> {
     transfer(ds, file_space, Buffer::Target(data))
 }

@@ -13,7 +13,9 @@ fn put_str(file: &File, name: &str, value: &str) -> hdf5::Result<()> {
     let v: VarLenUnicode = value
         .parse()
         .map_err(|e| hdf5::Error::Internal(format!("attribute {name}: {e}")))?;
-    file.new_attr::<VarLenUnicode>().create(name)?.write_scalar(&v)
+    file.new_attr::<VarLenUnicode>()
+        .create(name)?
+        .write_scalar(&v)
 }
 
 fn put<T: H5Type>(file: &File, name: &str, value: T) -> hdf5::Result<()> {
@@ -69,7 +71,10 @@ impl Reader<'_> {
             return Err(self.err(name, format!("expected type {want}, found {desc}")));
         }
         if attr.size() != 1 {
-            return Err(self.err(name, format!("expected one value, found shape {:?}", attr.shape())));
+            return Err(self.err(
+                name,
+                format!("expected one value, found shape {:?}", attr.shape()),
+            ));
         }
         let values = attr
             .read_raw::<T>()
@@ -83,7 +88,10 @@ impl Reader<'_> {
     fn string(&self, name: &str) -> Result<String, CaseError> {
         let (attr, desc) = self.open(name)?;
         if attr.size() != 1 {
-            return Err(self.err(name, format!("expected one string, found shape {:?}", attr.shape())));
+            return Err(self.err(
+                name,
+                format!("expected one string, found shape {:?}", attr.shape()),
+            ));
         }
         let read_err = |e: hdf5::Error| self.err(name, format!("cannot read: {e}"));
         let text = match desc {
@@ -109,7 +117,10 @@ impl Reader<'_> {
             return Err(self.err(name, format!("expected type {want}, found {desc}")));
         }
         if attr.ndim() > 1 {
-            return Err(self.err(name, format!("expected a 1-D array, found shape {:?}", attr.shape())));
+            return Err(self.err(
+                name,
+                format!("expected a 1-D array, found shape {:?}", attr.shape()),
+            ));
         }
         attr.read_raw::<u64>()
             .map_err(|e| self.err(name, format!("cannot read: {e}")))
@@ -121,9 +132,18 @@ impl Reader<'_> {
 pub fn read_header(file: &File, path: &Path) -> Result<CaseHeader, CaseError> {
     let r = Reader { file, path };
     let not_case = |why: String| {
-        CaseError::new(path, CaseErrorKind::NotACase, format!("not a pfem-mpi case file ({why})"))
+        CaseError::new(
+            path,
+            CaseErrorKind::NotACase,
+            format!("not a pfem-mpi case file ({why})"),
+        )
     };
-    if !file.attr_names().unwrap_or_default().iter().any(|n| n == "format") {
+    if !file
+        .attr_names()
+        .unwrap_or_default()
+        .iter()
+        .any(|n| n == "format")
+    {
         return Err(not_case("no attribute format".to_string()));
     }
     let format = r.string("format")?;
@@ -135,7 +155,9 @@ pub fn read_header(file: &File, path: &Path) -> Result<CaseHeader, CaseError> {
         return Err(CaseError::new(
             path,
             CaseErrorKind::TooNew,
-            format!("format_version {format_version} is newer than this pfem-mpi ({FORMAT_VERSION})"),
+            format!(
+                "format_version {format_version} is newer than this pfem-mpi ({FORMAT_VERSION})"
+            ),
         ));
     }
     if format_version == 0 {

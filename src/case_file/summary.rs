@@ -12,7 +12,11 @@ fn num(x: f64) -> String {
     if x == 0.0 || (1e-3..1e6).contains(&a) {
         let s = format!("{x:.6}");
         let s = s.trim_end_matches('0').trim_end_matches('.');
-        if s == "-0" { "0".to_string() } else { s.to_string() }
+        if s == "-0" {
+            "0".to_string()
+        } else {
+            s.to_string()
+        }
     } else {
         format!("{x:.4e}")
     }
@@ -75,10 +79,18 @@ pub fn render(
             );
         }
         Err(e) => {
-            line("scene", format!("from {} (cannot be read: {e})", h.scene_source));
+            line(
+                "scene",
+                format!("from {} (cannot be read: {e})", h.scene_source),
+            );
             line(
                 "progress",
-                format!("step {}, load factor {}, time {}", h.step, num(h.load_factor), num(h.time)),
+                format!(
+                    "step {}, load factor {}, time {}",
+                    h.step,
+                    num(h.load_factor),
+                    num(h.time)
+                ),
             );
         }
     }
@@ -110,7 +122,10 @@ pub fn render(
             _ => Some((i, m)),
         });
     if let Some((i, m)) = largest {
-        line("displacement", format!("max |u| = {} m at gid {}", num(m), gid[i]));
+        line(
+            "displacement",
+            format!("max |u| = {} m at gid {}", num(m), gid[i]),
+        );
     }
     for (k, g) in h.tracked_gids.iter().enumerate() {
         let text = match gid.iter().position(|x| x == g) {

@@ -22,6 +22,8 @@ pub struct LocalMesh {
     pub n_owned: usize,
     /// Rank owning each local point.
     pub owner: Vec<i32>,
+    /// Local particle spacing per point.
+    pub h: Vec<f64>,
     /// Kept triangles touching an owned particle, CCW, smallest-gid vertex first, sorted by gids.
     pub tris: Vec<[u32; 3]>,
     /// Whether this rank owns the triangle: the owner of its smallest-gid vertex (fixed rule).
@@ -47,13 +49,13 @@ impl LocalMesh {
         points: Vec<[f64; 2]>,
         gids: Vec<u64>,
         owner: Vec<i32>,
-        h: &[f64],
+        h: Vec<f64>,
         n_owned: usize,
         rank: i32,
         alpha: f64,
     ) -> Result<LocalMesh, MeshError> {
         let all = delaunay(&points, &gids).map_err(|e| MeshError(format!("Delaunay triangulation failed: {e}")))?;
-        let keep = alpha_keep(&points, &all, h, alpha);
+        let keep = alpha_keep(&points, &all, &h, alpha);
         let mut tris: Vec<[u32; 3]> = all
             .iter()
             .zip(&keep)
@@ -79,6 +81,7 @@ impl LocalMesh {
             gids,
             n_owned,
             owner,
+            h,
             tris,
             tri_owned,
             on_boundary,

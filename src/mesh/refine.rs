@@ -45,8 +45,9 @@ impl Plan {
 
 /// Plans refinement of `mesh`. `h[p]` is the spacing of local point p; `protected(p)` marks owned
 /// particles that must neither move nor vanish (tracked, constrained or boundary particles).
-pub fn plan(mesh: &LocalMesh, h: &[f64], protected: impl Fn(usize) -> bool, params: &RefineParams) -> Plan {
+pub fn plan(mesh: &LocalMesh, protected: impl Fn(usize) -> bool, params: &RefineParams) -> Plan {
     let n = mesh.n_owned;
+    let h = &mesh.h;
     let mut edges: BTreeSet<(u64, u64, u32, u32)> = BTreeSet::new();
     let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n];
     for t in &mesh.tris {
@@ -122,14 +123,13 @@ mod tests {
         }
         let n = pts.len();
         let gids = (0..n as u64).collect();
-        LocalMesh::build(pts, gids, vec![0; n], &vec![h; n], n, 0, 1.3).unwrap()
+        LocalMesh::build(pts, gids, vec![0; n], vec![h; n], n, 0, 1.3).unwrap()
     }
 
     #[test]
     fn regular_lattice_needs_nothing() {
         let m = lattice(6, 5, 0.5, |_| [0.0, 0.0]);
-        let h = vec![0.5; m.points.len()];
-        let p = plan(&m, &h, |_| false, &RefineParams::default());
+        let p = plan(&m, |_| false, &RefineParams::default());
         assert!(p.is_empty(), "{p:?}");
     }
 
@@ -137,8 +137,7 @@ mod tests {
     fn close_pair_loses_the_larger_id_and_long_edges_split() {
         // Particle 8 (interior) pushed next to particle 7.
         let m = lattice(5, 5, 1.0, |i| if i == 12 { [-0.7, 0.0] } else { [0.0, 0.0] });
-        let h = vec![1.0; m.points.len()];
-        let p = plan(&m, &h, |_| false, &RefineParams::default());
+        let p = plan(&m, |_| false, &RefineParams::default());
         assert_eq!(p.remove, vec![12]);
         assert!(!p.split.is_empty(), "the gap left at x = 2 has long edges");
         for [a, b] in &p.split {
@@ -149,13 +148,12 @@ mod tests {
     #[test]
     fn smoothing_moves_only_interior_unprotected_particles() {
         let m = lattice(5, 5, 1.0, |i| if i == 12 { [0.2, 0.1] } else { [0.0, 0.0] });
-        let h = vec![1.0; m.points.len()];
         let params = RefineParams { smooth: true, ..Default::default() };
-        let p = plan(&m, &h, |_| false, &params);
+        let p = plan(&m, |_| false, &params);
         assert!(p.smooth.iter().all(|(i, _)| !m.on_boundary[*i as usize]));
         let (_, target) = p.smooth.iter().find(|(i, _)| *i == 12).expect("12 is smoothed");
         assert!(dist_to(*target, [2.0, 2.0]) < 0.1);
-        let none = plan(&m, &h, |i| i == 12, &params);
+        let none = plan(&m, |i| i == 12, &params);
         assert!(none.smooth.iter().all(|(i, _)| *i != 12));
     }
 }

@@ -1,6 +1,7 @@
 //! The PFEM step loop (the method's Fig. 1): remesh, map, solve, update, output, checkpoint.
 
 mod progress;
+mod refinement;
 mod simulation;
 
 pub use simulation::{Simulation, StepReport};

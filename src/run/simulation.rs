@@ -19,11 +19,11 @@ use std::path::{Path, PathBuf};
 const IMBALANCE_LIMIT: f64 = 1.2;
 
 pub struct Simulation {
-    model: Model,
-    header: CaseHeader,
-    particles: Particles,
-    ghosts: Ghosts,
-    tri_states: TriStates,
+    pub(super) model: Model,
+    pub(super) header: CaseHeader,
+    pub(super) particles: Particles,
+    pub(super) ghosts: Ghosts,
+    pub(super) tri_states: TriStates,
     first_step: u64,
 }
 
@@ -105,6 +105,15 @@ impl Simulation {
     /// Collective. Delaunay of owned particles plus halo, alpha shape, triangles around owned
     /// particles.
     pub fn remesh(&mut self, world: &Comm) -> Result<LocalMesh, String> {
+        let mesh = self.build_mesh(world)?;
+        if self.refine(world, &mesh)? {
+            return self.build_mesh(world);
+        }
+        Ok(mesh)
+    }
+
+    /// Collective. The mesh of the current particles, without refinement.
+    pub(super) fn build_mesh(&mut self, world: &Comm) -> Result<LocalMesh, String> {
         let h_max = max_f64(world, self.particles.h.iter().copied().fold(0.0, f64::max));
         let width = halo_width(self.model.scene.mesh.alpha, h_max);
         let (_halo, ghosts) = self.particles.ghosts(world, width).map_err(err)?;
@@ -116,7 +125,7 @@ impl Simulation {
         let gids = p.gid.iter().chain(&g.gid).copied().collect();
         let owner = std::iter::repeat_n(rank, p.len()).chain(g.owner.iter().copied()).collect();
         let h: Vec<f64> = p.h.iter().chain(&g.h).copied().collect();
-        LocalMesh::build(points, gids, owner, &h, p.len(), rank, self.model.scene.mesh.alpha).map_err(err)
+        LocalMesh::build(points, gids, owner, h, p.len(), rank, self.model.scene.mesh.alpha).map_err(err)
     }
 
     /// Start-of-step Gauss states on the new mesh (rank-local).
@@ -125,7 +134,7 @@ impl Simulation {
         map_states(&self.tri_states, mesh, &at_points).0
     }
 
-    fn reference_position(&self, mesh: &LocalMesh, p: usize) -> [f64; 2] {
+    pub(super) fn reference_position(&self, mesh: &LocalMesh, p: usize) -> [f64; 2] {
         let n = mesh.n_owned;
         if p < n {
             self.particles.reference_position(p)
@@ -236,7 +245,7 @@ impl Simulation {
     /// Collective. METIS k-way on the mesh graph of the particles, then migration. Gauss states
     /// are recovered from the particles afterwards.
     fn repartition(&mut self, world: &Comm) -> Result<(), String> {
-        let mesh = self.remesh(world)?;
+        let mesh = self.build_mesh(world)?;
         let n = mesh.n_owned;
         let mut adj: Vec<Vec<u64>> = vec![Vec::new(); n];
         for t in &mesh.tris {

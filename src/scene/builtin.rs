@@ -4,8 +4,14 @@
 /// `(name, TOML text)` of every built-in scene.
 pub const BUILTINS: &[(&str, &str)] = &[
     ("cantilever", include_str!("builtin/cantilever.toml")),
-    ("footing-shallow", include_str!("builtin/footing-shallow.toml")),
-    ("block-compression", include_str!("builtin/block-compression.toml")),
+    (
+        "footing-shallow",
+        include_str!("builtin/footing-shallow.toml"),
+    ),
+    (
+        "block-compression",
+        include_str!("builtin/block-compression.toml"),
+    ),
 ];
 
 /// TOML text of the built-in scene `name`.

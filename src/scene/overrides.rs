@@ -35,10 +35,12 @@ fn parse_path(text: &str) -> Result<FieldPath, String> {
                 .find(']')
                 .filter(|_| rest.starts_with('['))
                 .ok_or_else(|| format!("malformed index in path \"{text}\""))?;
-            let index: usize = rest[1..close]
-                .trim()
-                .parse()
-                .map_err(|_| format!("index \"{}\" in path \"{text}\" is not a whole number", &rest[1..close]))?;
+            let index: usize = rest[1..close].trim().parse().map_err(|_| {
+                format!(
+                    "index \"{}\" in path \"{text}\" is not a whole number",
+                    &rest[1..close]
+                )
+            })?;
             segs.push(Segment::Index(index));
             rest = &rest[close + 1..];
         }
@@ -133,9 +135,18 @@ mod tests {
 
     #[test]
     fn values_are_typed_and_bare_words_are_strings() {
-        assert_eq!(SetArg::parse("mesh.h=0.25").unwrap().value, Value::Float(0.25));
-        assert_eq!(SetArg::parse("steps.count=20").unwrap().value, Value::Integer(20));
-        assert_eq!(SetArg::parse("mesh.refine=false").unwrap().value, Value::Boolean(false));
+        assert_eq!(
+            SetArg::parse("mesh.h=0.25").unwrap().value,
+            Value::Float(0.25)
+        );
+        assert_eq!(
+            SetArg::parse("steps.count=20").unwrap().value,
+            Value::Integer(20)
+        );
+        assert_eq!(
+            SetArg::parse("mesh.refine=false").unwrap().value,
+            Value::Boolean(false)
+        );
         assert_eq!(
             SetArg::parse("material.model=tresca").unwrap().value,
             Value::String("tresca".to_string())
@@ -147,9 +158,17 @@ mod tests {
 
     #[test]
     fn apply_creates_tables_and_indexes_arrays() {
-        let mut t: toml::Table = "[[fixed]]\nwhere = \"x <= 0\"\ndofs = [\"x\"]".parse().unwrap();
-        SetArg::parse("gravity.g=[0.0, -9.81]").unwrap().apply(&mut t).unwrap();
-        SetArg::parse("fixed[0].dofs=[\"y\"]").unwrap().apply(&mut t).unwrap();
+        let mut t: toml::Table = "[[fixed]]\nwhere = \"x <= 0\"\ndofs = [\"x\"]"
+            .parse()
+            .unwrap();
+        SetArg::parse("gravity.g=[0.0, -9.81]")
+            .unwrap()
+            .apply(&mut t)
+            .unwrap();
+        SetArg::parse("fixed[0].dofs=[\"y\"]")
+            .unwrap()
+            .apply(&mut t)
+            .unwrap();
         assert_eq!(t["gravity"]["g"][1].as_float(), Some(-9.81));
         assert_eq!(t["fixed"][0]["dofs"][0].as_str(), Some("y"));
         let (path, msg) = SetArg::parse("fixed[3].dofs=[\"y\"]")

@@ -65,8 +65,13 @@ impl Selector {
     pub fn parse(text: &str) -> Result<Self, String> {
         let mut conditions = Vec::new();
         for term in text.split(" and ") {
-            conditions.push(parse_condition(term.trim()).ok_or_else(|| {
-                format!("cannot read \"{}\" in \"{text}\": {SYNTAX_HELP}", term.trim())
+            let term = term.trim();
+            conditions.push(parse_condition(term).ok_or_else(|| {
+                if term == text.trim() {
+                    format!("cannot read \"{term}\": {SYNTAX_HELP}")
+                } else {
+                    format!("cannot read \"{term}\" in \"{text}\": {SYNTAX_HELP}")
+                }
             })?);
         }
         Ok(Selector { conditions })
@@ -174,7 +179,14 @@ mod tests {
 
     #[test]
     fn rejects_bad_syntax_with_help() {
-        for bad in ["z <= 1", "x < 1", "x <= one", "x <= inf", "", "x <= 1 or y >= 2"] {
+        for bad in [
+            "z <= 1",
+            "x < 1",
+            "x <= one",
+            "x <= inf",
+            "",
+            "x <= 1 or y >= 2",
+        ] {
             let e = Selector::parse(bad).unwrap_err();
             assert!(e.contains("expected comparisons"), "{bad}: {e}");
         }

@@ -6,7 +6,10 @@ const CANTILEVER: &str = include_str!("builtin/cantilever.toml");
 
 /// The cantilever scene file with `from` replaced by `to`, read as file `cantilever.toml`.
 fn edited(from: &str, to: &str) -> Result<Scene, SceneError> {
-    assert!(CANTILEVER.contains(from), "test edit target {from:?} not in the scene");
+    assert!(
+        CANTILEVER.contains(from),
+        "test edit target {from:?} not in the scene"
+    );
     Scene::from_toml(&CANTILEVER.replacen(from, to, 1), "cantilever.toml", &[])
 }
 
@@ -21,7 +24,10 @@ fn builtins_parse_validate_and_round_trip() {
         let (scene, resolved) = load_scene(name, &[]).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(&scene.name, name);
         let again = Scene::from_toml(&resolved, name, &[]).unwrap();
-        assert_eq!(again, scene, "{name} does not round-trip through its resolved TOML");
+        assert_eq!(
+            again, scene,
+            "{name} does not round-trip through its resolved TOML"
+        );
         assert_eq!(again.to_toml(), resolved);
     }
     let (footing, _) = load_scene("footing-shallow", &[]).unwrap();
@@ -58,8 +64,14 @@ fn bad_value_message_names_scene_and_field() {
 fn unknown_key_is_named() {
     let e = edited("alpha = 1.3", "alpah = 1.3").unwrap_err();
     assert_eq!(e.field.as_deref(), Some("mesh.alpah"), "{e}");
-    assert!(e.to_string().contains("field mesh.alpah: unknown key"), "{e}");
-    assert!(e.message.contains("alpha"), "should list the valid keys: {e}");
+    assert!(
+        e.to_string().contains("field mesh.alpah: unknown key"),
+        "{e}"
+    );
+    assert!(
+        e.message.contains("alpha"),
+        "should list the valid keys: {e}"
+    );
 
     let e = edited("[steps]", "[stepz]").unwrap_err();
     assert_eq!(e.field.as_deref(), Some("stepz"), "{e}");
@@ -123,42 +135,140 @@ fn bad_selector_is_named() {
 #[test]
 fn validation_messages_name_fields() {
     let cases = [
-        ("poisson = 0.2", "poisson = 0.5", "material.poisson", "must be > -1 and < 0.5 (got 0.5)"),
-        ("poisson = 0.2", "poisson = -1.0", "material.poisson", "(got -1)"),
-        ("young = 12.0e6", "young = 0.0", "material.young", "must be > 0 (got 0)"),
-        ("alpha = 1.3", "alpha = 0.0", "mesh.alpha", "must be > 0 (got 0)"),
-        ("alpha = 1.3", "alpha = 0.5", "mesh.alpha", "must be >= 0.7071"),
-        ("count = 50", "count = 0", "steps.count", "must be >= 1 (got 0)"),
-        ("density = 0.0", "density = -1.0", "material.density", "must be >= 0"),
-        ("checkpoint_keep = 3", "checkpoint_keep = 0", "output.checkpoint_keep", ">= 1"),
-        ("newton_rtol = 1e-9", "newton_rtol = 0.0", "solver.newton_rtol", "> 0 and < 1"),
-        ("newton_max_it = 25", "newton_max_it = 0", "solver.newton_max_it", ">= 1"),
+        (
+            "poisson = 0.2",
+            "poisson = 0.5",
+            "material.poisson",
+            "must be > -1 and < 0.5 (got 0.5)",
+        ),
+        (
+            "poisson = 0.2",
+            "poisson = -1.0",
+            "material.poisson",
+            "(got -1)",
+        ),
+        (
+            "young = 12.0e6",
+            "young = 0.0",
+            "material.young",
+            "must be > 0 (got 0)",
+        ),
+        (
+            "alpha = 1.3",
+            "alpha = 0.0",
+            "mesh.alpha",
+            "must be > 0 (got 0)",
+        ),
+        (
+            "alpha = 1.3",
+            "alpha = 0.5",
+            "mesh.alpha",
+            "must be >= 0.7071",
+        ),
+        (
+            "count = 50",
+            "count = 0",
+            "steps.count",
+            "must be >= 1 (got 0)",
+        ),
+        (
+            "density = 0.0",
+            "density = -1.0",
+            "material.density",
+            "must be >= 0",
+        ),
+        (
+            "checkpoint_keep = 3",
+            "checkpoint_keep = 0",
+            "output.checkpoint_keep",
+            ">= 1",
+        ),
+        (
+            "newton_rtol = 1e-9",
+            "newton_rtol = 0.0",
+            "solver.newton_rtol",
+            "> 0 and < 1",
+        ),
+        (
+            "newton_max_it = 25",
+            "newton_max_it = 0",
+            "solver.newton_max_it",
+            ">= 1",
+        ),
         ("g = [0.0, 0.0]", "g = [0.0, nan]", "gravity.g", "finite"),
-        ("name = \"cantilever\"", "name = \"\"", "name", "must not be empty"),
-        ("size = [10.0, 1.0]", "size = [10.0, -1.0]", "body.rectangles[0].size", "> 0"),
-        ("size = [10.0, 1.0]", "size = [10.05, 1.0]", "body.rectangles[0].size", "whole number"),
-        ("rectangles = [{ origin = [0.0, 0.0], size = [10.0, 1.0] }]", "rectangles = []",
-         "body.rectangles", "at least one"),
-        ("at = [10.0, 0.5]", "at = [12.0, 0.5]", "point_load[0].at", "within one particle spacing"),
-        ("dofs = [\"x\", \"y\"]", "dofs = []", "fixed[0].dofs", "at least one"),
-        ("dofs = [\"x\", \"y\"]", "dofs = [\"x\", \"x\"]", "fixed[0].dofs", "lists \"x\" twice"),
-        ("model = \"linear-elastic\"", "model = \"tresca\"", "material.cu",
-         "must be > 0 for model \"tresca\" (got 0)"),
-        ("kind = \"cantilever\"", "kind = \"footing\"", "history.kind", "no [[prescribed]]"),
+        (
+            "name = \"cantilever\"",
+            "name = \"\"",
+            "name",
+            "must not be empty",
+        ),
+        (
+            "size = [10.0, 1.0]",
+            "size = [10.0, -1.0]",
+            "body.rectangles[0].size",
+            "> 0",
+        ),
+        (
+            "size = [10.0, 1.0]",
+            "size = [10.05, 1.0]",
+            "body.rectangles[0].size",
+            "whole number",
+        ),
+        (
+            "rectangles = [{ origin = [0.0, 0.0], size = [10.0, 1.0] }]",
+            "rectangles = []",
+            "body.rectangles",
+            "at least one",
+        ),
+        (
+            "at = [10.0, 0.5]",
+            "at = [12.0, 0.5]",
+            "point_load[0].at",
+            "within one particle spacing",
+        ),
+        (
+            "dofs = [\"x\", \"y\"]",
+            "dofs = []",
+            "fixed[0].dofs",
+            "at least one",
+        ),
+        (
+            "dofs = [\"x\", \"y\"]",
+            "dofs = [\"x\", \"x\"]",
+            "fixed[0].dofs",
+            "lists \"x\" twice",
+        ),
+        (
+            "model = \"linear-elastic\"",
+            "model = \"tresca\"",
+            "material.cu",
+            "must be > 0 for model \"tresca\" (got 0)",
+        ),
+        (
+            "kind = \"cantilever\"",
+            "kind = \"footing\"",
+            "history.kind",
+            "no [[prescribed]]",
+        ),
         ("h = 0.125", "h = 1e-6", "mesh.h", "more than the limit"),
     ];
     for (from, to, field, text) in cases {
         let e = edited(from, to).expect_err(to);
         assert_eq!(e.field.as_deref(), Some(field), "{to}: {e}");
         assert!(e.message.contains(text), "{to}: {e}");
-        assert!(e.to_string().starts_with(&format!("scene 'cantilever.toml': field {field}: ")));
+        assert!(e
+            .to_string()
+            .starts_with(&format!("scene 'cantilever.toml': field {field}: ")));
     }
 }
 
 #[test]
 fn toml_syntax_error_gives_line() {
     let e = edited("h = 0.125", "h = = 0.125").unwrap_err();
-    assert!(e.message.starts_with("invalid TOML at line 9, column 5: "), "{e}");
+    assert!(
+        e.message.starts_with("invalid TOML at line 9, column 5: "),
+        "{e}"
+    );
     assert!(!e.message.contains('\n'), "{e}");
     assert!(e.field.is_none());
 }
@@ -203,7 +313,11 @@ fn set_errors_name_the_path() {
     let e = with_sets(&["mesh.hh=0.2"]).unwrap_err();
     assert_eq!(e.set.as_deref(), Some("mesh.hh=0.2"));
     assert_eq!(e.field.as_deref(), Some("mesh.hh"));
-    assert!(e.to_string().starts_with("scene 'cantilever': --set mesh.hh=0.2: field mesh.hh: no such key"), "{e}");
+    assert!(
+        e.to_string()
+            .starts_with("scene 'cantilever': --set mesh.hh=0.2: field mesh.hh: no such key"),
+        "{e}"
+    );
 
     let e = with_sets(&["mseh.h=0.2"]).unwrap_err();
     assert_eq!(e.field.as_deref(), Some("mseh"), "{e}");
@@ -240,14 +354,26 @@ fn set_errors_name_the_path() {
 #[test]
 fn load_scene_by_path_and_unknown_name() {
     let e = load_scene("cantileverr", &[]).unwrap_err();
-    assert!(e.message.contains("cantilever, footing-shallow, block-compression"), "{e}");
+    assert!(
+        e.message
+            .contains("cantilever, footing-shallow, block-compression"),
+        "{e}"
+    );
     let e = load_scene("/nonexistent/dir/scene.toml", &[]).unwrap_err();
-    assert!(e.to_string().starts_with("scene '/nonexistent/dir/scene.toml': cannot read"), "{e}");
+    assert!(
+        e.to_string()
+            .starts_with("scene '/nonexistent/dir/scene.toml': cannot read"),
+        "{e}"
+    );
 
     let dir = std::env::temp_dir().join(format!("pfem-scene-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("beam.toml");
-    std::fs::write(&path, CANTILEVER.replace("name = \"cantilever\"", "name = \"beam\"")).unwrap();
+    std::fs::write(
+        &path,
+        CANTILEVER.replace("name = \"cantilever\"", "name = \"beam\""),
+    )
+    .unwrap();
     let (s, resolved) = load_scene(path.to_str().unwrap(), &["steps.count=7".to_string()]).unwrap();
     assert_eq!(s.name, "beam");
     assert_eq!(s.steps.count, 7);

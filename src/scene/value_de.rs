@@ -70,7 +70,10 @@ fn describe_expected(exp: &dyn Expected) -> String {
         "a sequence" => "an array".to_string(),
         _ if text.starts_with("struct ") || text.starts_with("a map") => "a table".to_string(),
         _ if text.starts_with("an array of length ") => {
-            format!("an array of {} values", &text["an array of length ".len()..])
+            format!(
+                "an array of {} values",
+                &text["an array of length ".len()..]
+            )
         }
         _ => text,
     }
@@ -127,10 +130,7 @@ impl de::Error for DeError {
         let message = if expected.is_empty() {
             "unknown key; this table takes no keys".to_string()
         } else {
-            format!(
-                "unknown key; expected one of {}",
-                expected.join(", ")
-            )
+            format!("unknown key; expected one of {}", expected.join(", "))
         };
         DeError {
             path: FieldPath::key(field),

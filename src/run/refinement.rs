@@ -1,0 +1,135 @@
+//! Applying the refinement plan (method Fig. 4) to the distributed particles: new global ids that
+//! do not depend on the rank count, state carried to new and moved particles.
+
+use super::Simulation;
+use crate::fem::recovery::{barycentric, interpolate_linear};
+use crate::material::GaussState;
+use crate::mesh::refine::{plan, RefineParams};
+use crate::mesh::LocalMesh;
+use crate::particles::flag;
+use pfem_partition::{allgather_u64, sum_f64, Comm};
+use std::collections::HashSet;
+
+const K: usize = GaussState::LEN;
+
+impl Simulation {
+    /// Collective. Inserts, removes and smooths particles as the scene asks; returns whether
+    /// anything changed anywhere (then the mesh must be rebuilt).
+    pub(super) fn refine(&mut self, world: &Comm, mesh: &LocalMesh) -> Result<bool, String> {
+        let settings = self.model.scene.mesh;
+        if !settings.refine && !settings.smooth {
+            return Ok(false);
+        }
+        let params = RefineParams {
+            smooth: settings.smooth,
+            ..Default::default()
+        };
+        let protected = |p: usize| {
+            self.particles.flags[p] & flag::TRACKED != 0
+                || mesh.on_boundary[p]
+                || self.model.step_bc(self.particles.reference_position(p)).iter().any(Option::is_some)
+        };
+        let mut plan = plan(mesh, protected, &params);
+        if !settings.refine {
+            plan.split.clear();
+            plan.remove.clear();
+        }
+        let changes = sum_f64(world, &[(plan.split.len() + plan.remove.len() + plan.smooth.len()) as f64])[0];
+        if changes == 0.0 {
+            return Ok(false);
+        }
+        let n = mesh.n_owned;
+        let value = |p: usize| if p < n { self.particles.state[p] } else { self.ghosts.state[p - n] };
+        let disp = |p: usize| if p < n { self.particles.displacement[p] } else { self.ghosts.displacement[p - n] };
+
+        // Smoothed particles take the old field's values at their new place.
+        let mut moved = HashSet::new();
+        let mut smoothed = Vec::new();
+        for &(p, target) in &plan.smooth {
+            if let Some((state, u)) = sample_star(mesh, p as usize, target, &value, &disp) {
+                smoothed.push((p as usize, target, state, u));
+                moved.insert(mesh.gids[p as usize]);
+            }
+        }
+        // New particles at edge midpoints; ids by the global sorted order of their edges.
+        let keys: Vec<u64> = plan.split.iter().flat_map(|[a, b]| [mesh.gids[*a as usize], mesh.gids[*b as usize]]).collect();
+        let mut all: Vec<[u64; 2]> = allgather_u64(world, &keys).chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+        all.sort_unstable();
+        let first_new = self.header.next_gid;
+        self.header.next_gid += all.len() as u64;
+
+        let mid = |x: [f64; 2], y: [f64; 2]| [0.5 * (x[0] + y[0]), 0.5 * (x[1] + y[1])];
+        let mut born = Vec::with_capacity(plan.split.len());
+        for [a, b] in &plan.split {
+            let (a, b) = (*a as usize, *b as usize);
+            let key = [mesh.gids[a], mesh.gids[b]];
+            let Ok(rank) = all.binary_search(&key) else {
+                return Err(format!("refinement: edge {key:?} missing from the global list"));
+            };
+            let (sa, sb) = (value(a), value(b));
+            let state: [f64; K] = std::array::from_fn(|k| 0.5 * (sa[k] + sb[k]));
+            born.push((
+                first_new + rank as u64,
+                mid(mesh.points[a], mesh.points[b]),
+                mid(disp(a), disp(b)),
+                0.5 * (mesh.h[a] + mesh.h[b]),
+                state,
+            ));
+        }
+        let p = &mut self.particles;
+        for (i, target, state, u) in smoothed {
+            p.position[i] = target;
+            p.displacement[i] = u;
+            p.state[i] = state;
+        }
+        for (gid, x, u, h, state) in born {
+            p.gid.push(gid);
+            p.position.push(x);
+            p.displacement.push(u);
+            p.h.push(h);
+            p.state.push(state);
+            p.flags.push(0);
+        }
+        let removed: HashSet<u64> = plan.remove.iter().map(|&r| mesh.gids[r as usize]).collect();
+        if !removed.is_empty() {
+            let keep: Vec<bool> = p.gid.iter().map(|g| !removed.contains(g)).collect();
+            retain(&mut p.gid, &keep);
+            retain(&mut p.position, &keep);
+            retain(&mut p.displacement, &keep);
+            retain(&mut p.h, &keep);
+            retain(&mut p.state, &keep);
+            retain(&mut p.flags, &keep);
+        }
+        p.sort_by_gid();
+        self.tri_states.forget_touching(&moved);
+        Ok(true)
+    }
+}
+
+fn retain<T: Copy>(v: &mut Vec<T>, keep: &[bool]) {
+    let mut i = 0;
+    v.retain(|_| {
+        i += 1;
+        keep[i - 1]
+    });
+}
+
+/// Linear interpolation of particle values at `target` inside a triangle around particle `p`.
+fn sample_star(
+    mesh: &LocalMesh,
+    p: usize,
+    target: [f64; 2],
+    value: &impl Fn(usize) -> [f64; K],
+    disp: &impl Fn(usize) -> [f64; 2],
+) -> Option<([f64; K], [f64; 2])> {
+    for t in mesh.tris.iter().filter(|t| t.contains(&(p as u32))) {
+        let [a, b, c] = t.map(|v| v as usize);
+        let bary = barycentric(mesh.points[a], mesh.points[b], mesh.points[c], target);
+        if bary.iter().all(|&l| l.is_finite() && l >= -1e-12) {
+            let state = interpolate_linear(bary, &[value(a), value(b), value(c)]);
+            let u = interpolate_linear(bary, &[disp(a), disp(b), disp(c)]);
+            return Some((state, u));
+        }
+    }
+    None
+}
