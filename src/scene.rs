@@ -84,7 +84,7 @@ use value_de::{DeErrorKind, ValueDeserializer};
 
 /// 1-based line and column of a byte offset, for TOML syntax errors.
 fn line_column(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
+    let before = text.get(..offset).unwrap_or(text);
     let line = before.matches('\n').count() + 1;
     let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
     (line, column)
@@ -160,14 +160,14 @@ impl Scene {
 
     /// `[[xmin, ymin], [xmax, ymax]]` of the body rectangles.
     pub fn bounding_box(&self) -> [[f64; 2]; 2] {
-        let mut bb = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
-        for r in &self.body.rectangles {
-            for axis in 0..2 {
-                bb[0][axis] = bb[0][axis].min(r.origin[axis]);
-                bb[1][axis] = bb[1][axis].max(r.origin[axis] + r.size[axis]);
-            }
-        }
-        bb
+        let empty = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
+        self.body.rectangles.iter().fold(empty, |[lo, hi], r| {
+            let top = [r.origin[0] + r.size[0], r.origin[1] + r.size[1]];
+            [
+                [lo[0].min(r.origin[0]), lo[1].min(r.origin[1])],
+                [hi[0].max(top[0]), hi[1].max(top[1])],
+            ]
+        })
     }
 
     /// Boundary slack of geometric selections: 1e-9 times the body's largest dimension.

@@ -118,6 +118,8 @@ impl Simulation {
         let width = halo_width(self.model.scene.mesh.alpha, h_max);
         let (_halo, ghosts) = self.particles.ghosts(world, width).map_err(err)?;
         self.ghosts = ghosts;
+        #[cfg(debug_assertions)]
+        check_halo(world, &self.particles, &self.ghosts, width)?;
         let p = &self.particles;
         let g = &self.ghosts;
         let rank = world.rank();
@@ -362,5 +364,34 @@ fn prune_checkpoints(dir: &Path, keep: usize) {
     let n = names.len();
     for p in names.into_iter().take(n.saturating_sub(keep.max(1))) {
         let _ = std::fs::remove_file(p);
+    }
+}
+
+/// Debug builds: every particle within the halo width of an owned one is on this rank, checked
+/// against the full cloud gathered everywhere (too costly for release runs).
+#[cfg(debug_assertions)]
+fn check_halo(world: &Comm, p: &Particles, g: &Ghosts, width: f64) -> Result<(), String> {
+    use pfem_partition::allgather_u64;
+    let mine: Vec<u64> = (0..p.len())
+        .flat_map(|i| [p.gid[i], p.position[i][0].to_bits(), p.position[i][1].to_bits()])
+        .collect();
+    let all = allgather_u64(world, &mine);
+    let present: std::collections::HashSet<u64> = p.gid.iter().chain(&g.gid).copied().collect();
+    let mut missing = None;
+    'outer: for c in all.chunks_exact(3) {
+        if present.contains(&c[0]) {
+            continue;
+        }
+        let q = [f64::from_bits(c[1]), f64::from_bits(c[2])];
+        for x in &p.position {
+            if (x[0] - q[0]).powi(2) + (x[1] - q[1]).powi(2) <= width * width {
+                missing = Some(c[0]);
+                break 'outer;
+            }
+        }
+    }
+    match pfem_partition::agree_on_error(world, missing.map(|m| format!("halo check: particle {m} is within the halo width {width} of an owned particle but not on rank {}", world.rank()))) {
+        Some(e) => Err(e),
+        None => Ok(()),
     }
 }

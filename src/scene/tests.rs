@@ -299,9 +299,9 @@ fn set_overrides_values() {
 
 #[test]
 fn set_defaults_that_the_file_omits() {
-    // The footing scene has no [output] keys beyond the defaults' names; --set must reach
-    // tables and keys that are absent from the text.
+    // --set must reach tables and keys that are absent from the text (defaults).
     let text = CANTILEVER.replace("[solver]\nnewton_max_it = 25\nnewton_rtol = 1e-9\n", "");
+    assert!(!text.contains("[solver]"));
     let sets = vec!["solver.newton_max_it=40".to_string()];
     let s = Scene::from_toml(&text, "cantilever.toml", &sets).unwrap();
     assert_eq!(s.solver.newton_max_it, 40);

@@ -1,0 +1,43 @@
+//! The cantilever benchmark (seed §4.1, reference.md §1): accuracy against the plane-strain
+//! Reissner solution and agreement between rank counts.
+
+mod common;
+use common::*;
+
+/// reference.md §1: extensible, shear-deformable beam, plane-strain modulus, (λ, u/L, v/L).
+const REISSNER: [(f64, f64, f64); 3] = [(2.0, 0.153, 0.485), (5.0, 0.378, 0.713), (10.0, 0.548, 0.8175)];
+
+fn at(rows: &[Vec<f64>], lambda: f64) -> &Vec<f64> {
+    rows.iter().find(|r| (r[1] - lambda).abs() < 1e-9).unwrap_or_else(|| panic!("no row at lambda {lambda}"))
+}
+
+#[test]
+fn default_mesh_is_within_one_percent_and_ranks_agree() {
+    let dir = workdir("cantilever");
+    ok(&dir, 1, &["new", "cantilever", "-o", "c.h5"]);
+    let mut runs = Vec::new();
+    for ranks in [1, 2, 3] {
+        let out = format!("r{ranks}");
+        ok(&dir, ranks, &["c.h5", "--out", &out]);
+        let (header, rows) = history(&dir.join(&out).join("history.csv"));
+        assert_eq!(header, ["step", "lambda", "u_over_L", "v_over_L"]);
+        assert_eq!(rows.len(), 50);
+        runs.push(rows);
+    }
+    for &(lambda, u, v) in &REISSNER[1..] {
+        let r = at(&runs[0], lambda);
+        let (eu, ev) = ((r[2] - u) / u, (r[3] - v) / v);
+        println!("lambda {lambda}: u/L {:.5} ({:+.2} %), v/L {:.5} ({:+.2} %)", r[2], 100.0 * eu, r[3], 100.0 * ev);
+        assert!(eu.abs() < 0.01 && ev.abs() < 0.01, "lambda {lambda}: {r:?} vs ({u}, {v})");
+    }
+    for (ranks, rows) in [(2, &runs[1]), (3, &runs[2])] {
+        let mut worst: f64 = 0.0;
+        for (a, b) in runs[0].iter().zip(rows.iter()) {
+            for c in 2..4 {
+                worst = worst.max(((a[c] - b[c]) / a[c]).abs());
+            }
+        }
+        println!("1 vs {ranks} ranks: largest relative difference {worst:.2e}");
+        assert!(worst < 1e-3, "{ranks} ranks differ from 1 rank by {worst}");
+    }
+}

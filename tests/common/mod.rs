@@ -1,0 +1,60 @@
+//! Helpers for tests that run the built binary, under mpirun when ranks > 1 (MPI can be
+//! initialised only once per process, so multi-rank tests launch processes).
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+pub fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_pfem-mpi")
+}
+
+/// A fresh directory under the target dir, unique per test.
+pub fn workdir(name: &str) -> PathBuf {
+    static N: AtomicUsize = AtomicUsize::new(0);
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}-{}-{}", std::process::id(), N.fetch_add(1, Ordering::SeqCst)));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("create test dir");
+    dir
+}
+
+/// Runs `pfem-mpi args` on `ranks` ranks (plain process for 1), in `dir`.
+pub fn run(dir: &Path, ranks: usize, args: &[&str]) -> Output {
+    let mut cmd = if ranks == 1 {
+        Command::new(bin())
+    } else {
+        let mut c = Command::new("mpirun");
+        c.args(["-n", &ranks.to_string(), "--oversubscribe", bin()]);
+        c
+    };
+    cmd.args(args)
+        .current_dir(dir)
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("OMPI_MCA_rmaps_base_oversubscribe", "1");
+    cmd.output().expect("launch pfem-mpi")
+}
+
+/// Like `run`, failing the test with the process output unless it succeeded.
+pub fn ok(dir: &Path, ranks: usize, args: &[&str]) -> String {
+    let out = run(dir, ranks, args);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "pfem-mpi {args:?} on {ranks} ranks failed\nstdout:\n{stdout}\nstderr:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+/// history.csv as (header, rows).
+pub fn history(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header = lines.next().expect("header").split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().expect("number")).collect())
+        .collect();
+    (header, rows)
+}
