@@ -90,11 +90,35 @@ pub fn generate_particles(scene: &Scene) -> ParticleSet {
         for span in spans {
             for i in span[0]..=span[1] {
                 let gid = set.len() as u64;
-                set.push_new(gid, [anchor[0] + i as f64 * h, y], h);
+                let p = [anchor[0] + i as f64 * h, y];
+                set.push_new(gid, jittered(scene, gid, p), h);
             }
         }
     }
     set
+}
+
+/// `p` moved by the scene's `body.jitter` when it lies more than h/2 inside a rectangle.
+fn jittered(scene: &Scene, gid: u64, p: [f64; 2]) -> [f64; 2] {
+    let (h, j) = (scene.mesh.h, scene.body.jitter);
+    let inside = scene.body.rectangles.iter().any(|r| {
+        (0..2).all(|c| p[c] > r.origin[c] + 0.5 * h && p[c] < r.origin[c] + r.size[c] - 0.5 * h)
+    });
+    if j == 0.0 || !inside {
+        return p;
+    }
+    let a = splitmix64(gid.wrapping_mul(2));
+    let b = splitmix64(gid.wrapping_mul(2) + 1);
+    let unit = |x: u64| (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+    [p[0] + 2.0 * j * h * unit(a), p[1] + 2.0 * j * h * unit(b)]
+}
+
+/// SplitMix64: a fixed, portable stream of pseudo-random bits from an integer.
+fn splitmix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 /// Global id of the particle nearest to `p` (ties go to the smaller id), with its distance.

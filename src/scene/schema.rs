@@ -45,6 +45,11 @@ pub struct Body {
     /// particle spacings, so that rectangle edges carry particles and adjacent rectangles share
     /// them.
     pub rectangles: Vec<Rectangle>,
+    /// Random offset of every particle lying more than h/2 inside a rectangle, as a fraction of
+    /// h in each direction (0 <= jitter < 0.5; default 0). Deterministic per particle id: an
+    /// irregular cloud for studying the mesher, with supports and loads left on the lattice.
+    #[serde(default)]
+    pub jitter: f64,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -80,6 +80,11 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
         }
     }
 
+    let jitter = s.body.jitter;
+    if !(0.0..0.5).contains(&jitter) {
+        return fail(root.join("body").join("jitter"), format!("must be in [0, 0.5) (got {jitter})"));
+    }
+
     let mesh = root.join("mesh");
     positive(mesh.join("h"), s.mesh.h)?;
     positive(mesh.join("alpha"), s.mesh.alpha)?;
