@@ -8,9 +8,9 @@ use std::path::PathBuf;
 fn main() {
     println!("cargo:rerun-if-changed=src/petsc/wrapper.h");
     println!("cargo:rerun-if-changed=build.rs");
-    let petsc = pkg_config::Config::new()
-        .probe("PETSc")
-        .expect("PETSc not found by pkg-config: install the native stack (README, `.ci/install-native`)");
+    let petsc = pkg_config::Config::new().probe("PETSc").expect(
+        "PETSc not found by pkg-config: install the native stack (README, `.ci/install-native`)",
+    );
     let mpi = pkg_config::Config::new()
         .cargo_metadata(false)
         .probe("ompi-c")

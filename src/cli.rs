@@ -13,10 +13,23 @@ built-in scenes: cantilever, footing-shallow, block-compression";
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
-    New { scene: String, out: PathBuf, sets: Vec<String> },
-    Info { file: PathBuf },
-    Mesh { file: PathBuf },
-    Run { case: PathBuf, out: Option<PathBuf>, until_step: Option<u64>, petsc: Vec<String> },
+    New {
+        scene: String,
+        out: PathBuf,
+        sets: Vec<String>,
+    },
+    Info {
+        file: PathBuf,
+    },
+    Mesh {
+        file: PathBuf,
+    },
+    Run {
+        case: PathBuf,
+        out: Option<PathBuf>,
+        until_step: Option<u64>,
+        petsc: Vec<String>,
+    },
     Help,
     Version,
 }
@@ -38,7 +51,9 @@ pub fn parse(args: &[String]) -> Result<Command, String> {
             let mut it = ours[1..].iter();
             while let Some(a) = it.next() {
                 match a.as_str() {
-                    "-o" | "--output" => out = Some(PathBuf::from(it.next().ok_or("-o needs a file name")?)),
+                    "-o" | "--output" => {
+                        out = Some(PathBuf::from(it.next().ok_or("-o needs a file name")?))
+                    }
                     "--set" => sets.push(it.next().ok_or("--set needs key=value")?.clone()),
                     s if s.starts_with('-') => return Err(format!("new: unknown option {s}")),
                     s if scene.is_none() => scene = Some(s.to_string()),
@@ -56,7 +71,11 @@ pub fn parse(args: &[String]) -> Result<Command, String> {
                 return Err(format!("{first}: give exactly one .h5 file"));
             };
             let file = PathBuf::from(file);
-            Ok(if first == "info" { Command::Info { file } } else { Command::Mesh { file } })
+            Ok(if first == "info" {
+                Command::Info { file }
+            } else {
+                Command::Mesh { file }
+            })
         }
         _ => {
             let mut case = None;
@@ -65,12 +84,19 @@ pub fn parse(args: &[String]) -> Result<Command, String> {
             let mut it = ours.iter();
             while let Some(a) = it.next() {
                 match a.as_str() {
-                    "--out" => out = Some(PathBuf::from(it.next().ok_or("--out needs a directory")?)),
+                    "--out" => {
+                        out = Some(PathBuf::from(it.next().ok_or("--out needs a directory")?))
+                    }
                     "--until-step" => {
                         let v = it.next().ok_or("--until-step needs a step number")?;
-                        until_step = Some(v.parse().map_err(|_| format!("--until-step: {v:?} is not a step number"))?);
+                        until_step =
+                            Some(v.parse().map_err(|_| {
+                                format!("--until-step: {v:?} is not a step number")
+                            })?);
                     }
-                    s if s.starts_with('-') => return Err(format!("unknown option {s} (PETSc options go after --)")),
+                    s if s.starts_with('-') => {
+                        return Err(format!("unknown option {s} (PETSc options go after --)"))
+                    }
                     s if case.is_none() => case = Some(PathBuf::from(s)),
                     s => return Err(format!("unexpected argument {s}")),
                 }
@@ -88,7 +114,10 @@ pub fn parse(args: &[String]) -> Result<Command, String> {
 /// Default output folder: the case's name with `.out` (`runs/case.h5` -> `runs/case.out`); a
 /// checkpoint `X.out/checkpoints/step_N.h5` continues in `X.out`.
 pub fn default_out_dir(case: &std::path::Path) -> PathBuf {
-    if let Some(dir) = case.parent().filter(|d| d.file_name().is_some_and(|n| n == "checkpoints")) {
+    if let Some(dir) = case
+        .parent()
+        .filter(|d| d.file_name().is_some_and(|n| n == "checkpoints"))
+    {
         if let Some(run_dir) = dir.parent() {
             return run_dir.to_path_buf();
         }
@@ -120,23 +149,40 @@ mod tests {
 
     #[test]
     fn new_with_sets() {
-        let c = parse(&args("new cantilever -o c.h5 --set mesh.h=0.25 --set steps.count=5")).unwrap();
+        let c = parse(&args(
+            "new cantilever -o c.h5 --set mesh.h=0.25 --set steps.count=5",
+        ))
+        .unwrap();
         assert_eq!(
             c,
-            Command::New { scene: "cantilever".into(), out: "c.h5".into(), sets: args("mesh.h=0.25 steps.count=5") }
+            Command::New {
+                scene: "cantilever".into(),
+                out: "c.h5".into(),
+                sets: args("mesh.h=0.25 steps.count=5")
+            }
         );
     }
 
     #[test]
     fn errors_name_the_problem() {
         assert!(parse(&args("new cantilever")).unwrap_err().contains("-o"));
-        assert!(parse(&args("case.h5 --until-step x")).unwrap_err().contains("--until-step"));
-        assert!(parse(&args("case.h5 -snes_monitor")).unwrap_err().contains("after --"));
+        assert!(parse(&args("case.h5 --until-step x"))
+            .unwrap_err()
+            .contains("--until-step"));
+        assert!(parse(&args("case.h5 -snes_monitor"))
+            .unwrap_err()
+            .contains("after --"));
     }
 
     #[test]
     fn out_dir_of_case_and_checkpoint() {
-        assert_eq!(default_out_dir("a/case.h5".as_ref()), PathBuf::from("a/case.out"));
-        assert_eq!(default_out_dir("a/case.out/checkpoints/step_000010.h5".as_ref()), PathBuf::from("a/case.out"));
+        assert_eq!(
+            default_out_dir("a/case.h5".as_ref()),
+            PathBuf::from("a/case.out")
+        );
+        assert_eq!(
+            default_out_dir("a/case.out/checkpoints/step_000010.h5".as_ref()),
+            PathBuf::from("a/case.out")
+        );
     }
 }

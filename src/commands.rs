@@ -21,17 +21,32 @@ pub fn execute(command: Command) -> i32 {
         Command::New { scene, out, sets } => new(&world, &scene, &out, &sets),
         Command::Info { file } => {
             if world.rank() == 0 {
-                summarize(&file).map(|s| print!("{s}")).map_err(|e| e.to_string())
+                summarize(&file)
+                    .map(|s| print!("{s}"))
+                    .map_err(|e| e.to_string())
             } else {
                 Ok(())
             }
         }
         Command::Mesh { file } => mesh(&world, &file),
-        Command::Run { case, out, until_step, petsc } => {
+        Command::Run {
+            case,
+            out,
+            until_step,
+            petsc,
+        } => {
             let out_dir = out.unwrap_or_else(|| default_out_dir(&case));
             match Petsc::initialize(&world, &petsc) {
                 // `petsc` is dropped (PetscFinalize) before `universe` (MPI_Finalize).
-                Ok(petsc) => run(&world, &petsc, &RunOptions { case, out_dir, until_step }),
+                Ok(petsc) => run(
+                    &world,
+                    &petsc,
+                    &RunOptions {
+                        case,
+                        out_dir,
+                        until_step,
+                    },
+                ),
                 Err(e) => Err(e.to_string()),
             }
         }
@@ -57,7 +72,12 @@ fn new(world: &Comm, scene: &str, out: &std::path::Path, sets: &[String]) -> Res
     }
     write_case(world, out, &header, &set).map_err(|e| e.to_string())?;
     if world.rank() == 0 {
-        println!("wrote {} ({} particles, scene {})", out.display(), header_particles(&set), scene_v.name);
+        println!(
+            "wrote {} ({} particles, scene {})",
+            out.display(),
+            header_particles(&set),
+            scene_v.name
+        );
     }
     Ok(())
 }

@@ -26,8 +26,15 @@ pub struct Measures {
 pub fn row(scene: &Scene, m: &Measures) -> Result<Vec<f64>, String> {
     match scene.history.kind {
         HistoryKind::Cantilever => {
-            let beam = scene.body.rectangles.first().ok_or("body.rectangles: empty")?;
-            let load = scene.point_load.first().ok_or("history.kind = \"cantilever\" needs a [[point_load]]")?;
+            let beam = scene
+                .body
+                .rectangles
+                .first()
+                .ok_or("body.rectangles: empty")?;
+            let load = scene
+                .point_load
+                .first()
+                .ok_or("history.kind = \"cantilever\" needs a [[point_load]]")?;
             let (l, d) = (beam.size[0], beam.size[1]);
             let ei = scene.material.young * d.powi(3) / 12.0;
             let p = (load.force[0].powi(2) + load.force[1].powi(2)).sqrt();
@@ -37,7 +44,10 @@ pub fn row(scene: &Scene, m: &Measures) -> Result<Vec<f64>, String> {
                 -m.tracked_displacement[1] / l,
             ])
         }
-        other => Err(format!("history.kind = \"{}\" is not available in this build yet", other.as_str())),
+        other => Err(format!(
+            "history.kind = \"{}\" is not available in this build yet",
+            other.as_str()
+        )),
     }
 }
 
@@ -57,7 +67,12 @@ impl HistoryFile {
             let mut lines = BufReader::new(f).lines();
             match lines.next() {
                 Some(Ok(h)) if h == header => {}
-                _ => return Err(format!("{}: columns differ from {header:?}; move it away to restart here", path.display())),
+                _ => {
+                    return Err(format!(
+                        "{}: columns differ from {header:?}; move it away to restart here",
+                        path.display()
+                    ))
+                }
             }
             for line in lines {
                 let line = line.map_err(|e| format!("{}: {e}", path.display()))?;
@@ -70,7 +85,10 @@ impl HistoryFile {
         let tmp = path.with_extension("csv.tmp");
         fs::write(&tmp, kept.join("\n") + "\n").map_err(|e| format!("{}: {e}", tmp.display()))?;
         fs::rename(&tmp, &path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let file = OpenOptions::new().append(true).open(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let file = OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
         Ok(HistoryFile { file, path })
     }
 

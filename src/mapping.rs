@@ -32,7 +32,11 @@ impl TriStates {
     /// Drops the triangles with a vertex in `moved` (their Gauss points are no longer where the
     /// states were computed).
     pub fn forget_touching(&mut self, moved: &std::collections::HashSet<u64>) {
-        let keep: Vec<bool> = self.keys.iter().map(|k| !k.iter().any(|g| moved.contains(g))).collect();
+        let keep: Vec<bool> = self
+            .keys
+            .iter()
+            .map(|k| !k.iter().any(|g| moved.contains(g)))
+            .collect();
         let mut i = 0;
         self.keys.retain(|_| {
             i += 1;
@@ -59,7 +63,11 @@ pub struct MapStats {
 
 /// States for `mesh`'s triangles: kept where the triangle existed before, otherwise interpolated
 /// from the particle values `at_points` (indexed like `mesh.points`).
-pub fn map_states(old: &TriStates, mesh: &LocalMesh, at_points: &[[f64; K]]) -> (Vec<[GaussState; 3]>, MapStats) {
+pub fn map_states(
+    old: &TriStates,
+    mesh: &LocalMesh,
+    at_points: &[[f64; K]],
+) -> (Vec<[GaussState; 3]>, MapStats) {
     let mut stats = MapStats::default();
     let states = (0..mesh.tris.len())
         .map(|t| {
@@ -69,10 +77,20 @@ pub fn map_states(old: &TriStates, mesh: &LocalMesh, at_points: &[[f64; K]]) -> 
             }
             stats.interpolated += 1;
             let tri = mesh.tris[t];
-            let v = [mesh.points[tri[0] as usize], mesh.points[tri[1] as usize], mesh.points[tri[2] as usize]];
-            let vals = [at_points[tri[0] as usize], at_points[tri[1] as usize], at_points[tri[2] as usize]];
+            let v = [
+                mesh.points[tri[0] as usize],
+                mesh.points[tri[1] as usize],
+                mesh.points[tri[2] as usize],
+            ];
+            let vals = [
+                at_points[tri[0] as usize],
+                at_points[tri[1] as usize],
+                at_points[tri[2] as usize],
+            ];
             let gp = p2_gauss_points(&straight_sided(&v));
-            gp.map(|p| GaussState::from_array(&interpolate_linear(barycentric(v[0], v[1], v[2], p), &vals)))
+            gp.map(|p| {
+                GaussState::from_array(&interpolate_linear(barycentric(v[0], v[1], v[2], p), &vals))
+            })
         })
         .collect();
     (states, stats)
@@ -81,7 +99,11 @@ pub fn map_states(old: &TriStates, mesh: &LocalMesh, at_points: &[[f64; K]]) -> 
 /// Particle values of the Gauss states: each triangle's linear extrapolation to its vertices,
 /// averaged over the triangles around an owned particle with their areas as weights. Owned
 /// particles in no triangle keep `previous`.
-pub fn recover_at_particles(mesh: &LocalMesh, states: &[[GaussState; 3]], previous: &[[f64; K]]) -> Vec<[f64; K]> {
+pub fn recover_at_particles(
+    mesh: &LocalMesh,
+    states: &[[GaussState; 3]],
+    previous: &[[f64; K]],
+) -> Vec<[f64; K]> {
     let n = mesh.n_owned;
     let mut sum = vec![[0.0; K]; n];
     let mut weight = vec![0.0; n];
@@ -100,6 +122,12 @@ pub fn recover_at_particles(mesh: &LocalMesh, states: &[[GaussState; 3]], previo
         }
     }
     (0..n)
-        .map(|i| if weight[i] > 0.0 { sum[i].map(|x| x / weight[i]) } else { previous[i] })
+        .map(|i| {
+            if weight[i] > 0.0 {
+                sum[i].map(|x| x / weight[i])
+            } else {
+                previous[i]
+            }
+        })
         .collect()
 }

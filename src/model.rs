@@ -16,16 +16,27 @@ impl Model {
     pub fn new(scene: &Scene) -> Result<Model, String> {
         let m = &scene.material;
         let material: Box<dyn Material> = match m.model {
-            MaterialModel::LinearElastic => Box::new(LinearElastic::new(m.young, m.poisson).map_err(|e| format!("material: {e}"))?),
-            MaterialModel::Tresca => return Err("material.model: \"tresca\" is not available in this build yet".into()),
+            MaterialModel::LinearElastic => Box::new(
+                LinearElastic::new(m.young, m.poisson).map_err(|e| format!("material: {e}"))?,
+            ),
+            MaterialModel::Tresca => {
+                return Err("material.model: \"tresca\" is not available in this build yet".into())
+            }
         };
         let mut size: f64 = 0.0;
         for r in &scene.body.rectangles {
-            size = size.max(r.size[0]).max(r.size[1]).max(r.origin[0].abs()).max(r.origin[1].abs());
+            size = size
+                .max(r.size[0])
+                .max(r.size[1])
+                .max(r.origin[0].abs())
+                .max(r.origin[1].abs());
         }
         Ok(Model {
             material,
-            body_force: [m.density * scene.gravity.g[0], m.density * scene.gravity.g[1]],
+            body_force: [
+                m.density * scene.gravity.g[0],
+                m.density * scene.gravity.g[1],
+            ],
             tol: 1e-9 * size.max(1.0),
             scene: scene.clone(),
         })

@@ -10,18 +10,51 @@ fn fails_with(dir: &std::path::Path, ranks: usize, args: &[&str], needles: &[&st
     assert!(!out.status.success(), "{args:?} should fail");
     assert!(!stderr.contains("panicked"), "{args:?} panicked:\n{stderr}");
     for n in needles {
-        assert!(stderr.contains(n), "{args:?}: message should name {n:?}:\n{stderr}");
+        assert!(
+            stderr.contains(n),
+            "{args:?}: message should name {n:?}:\n{stderr}"
+        );
     }
-    assert!(!dir.join("bad.h5").exists(), "no half-written case file may be left");
+    assert!(
+        !dir.join("bad.h5").exists(),
+        "no half-written case file may be left"
+    );
 }
 
 #[test]
 fn bad_scene_values_name_the_field() {
     let dir = workdir("bad-scene");
-    fails_with(&dir, 1, &["new", "cantilever", "-o", "bad.h5", "--set", "mesh.h=-1"], &["mesh.h", "> 0"]);
-    fails_with(&dir, 1, &["new", "cantilever", "-o", "bad.h5", "--set", "material.poisson=0.7"], &["material.poisson"]);
-    fails_with(&dir, 1, &["new", "cantilever", "-o", "bad.h5", "--set", "mesh.hh=1"], &["mesh.hh"]);
-    fails_with(&dir, 1, &["new", "no-such-scene", "-o", "bad.h5"], &["no-such-scene"]);
+    fails_with(
+        &dir,
+        1,
+        &["new", "cantilever", "-o", "bad.h5", "--set", "mesh.h=-1"],
+        &["mesh.h", "> 0"],
+    );
+    fails_with(
+        &dir,
+        1,
+        &[
+            "new",
+            "cantilever",
+            "-o",
+            "bad.h5",
+            "--set",
+            "material.poisson=0.7",
+        ],
+        &["material.poisson"],
+    );
+    fails_with(
+        &dir,
+        1,
+        &["new", "cantilever", "-o", "bad.h5", "--set", "mesh.hh=1"],
+        &["mesh.hh"],
+    );
+    fails_with(
+        &dir,
+        1,
+        &["new", "no-such-scene", "-o", "bad.h5"],
+        &["no-such-scene"],
+    );
     std::fs::write(dir.join("s.toml"), "name = \"x\"\n[mesh]\nh = \"big\"\n").unwrap();
     fails_with(&dir, 1, &["new", "s.toml", "-o", "bad.h5"], &["s.toml"]);
 }
@@ -47,10 +80,26 @@ fn bad_command_lines_explain_usage() {
 #[test]
 fn a_step_that_cannot_converge_stops_all_ranks_with_the_reason() {
     let dir = workdir("bad-newton");
-    ok(&dir, 1, &["new", "cantilever", "-o", "c.h5", "--set", "mesh.h=0.25", "--set", "steps.count=2"]);
+    ok(
+        &dir,
+        1,
+        &[
+            "new",
+            "cantilever",
+            "-o",
+            "c.h5",
+            "--set",
+            "mesh.h=0.25",
+            "--set",
+            "steps.count=2",
+        ],
+    );
     let out = run(&dir, 2, &["c.h5", "--", "-snes_max_it", "1"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
-    assert!(stderr.contains("step 1") && stderr.contains("Newton"), "{stderr}");
+    assert!(
+        stderr.contains("step 1") && stderr.contains("Newton"),
+        "{stderr}"
+    );
     assert!(!stderr.contains("panicked"), "{stderr}");
 }

@@ -5,10 +5,16 @@ mod common;
 use common::*;
 
 /// reference.md §1: extensible, shear-deformable beam, plane-strain modulus, (λ, u/L, v/L).
-const REISSNER: [(f64, f64, f64); 3] = [(2.0, 0.153, 0.485), (5.0, 0.378, 0.713), (10.0, 0.548, 0.8175)];
+const REISSNER: [(f64, f64, f64); 3] = [
+    (2.0, 0.153, 0.485),
+    (5.0, 0.378, 0.713),
+    (10.0, 0.548, 0.8175),
+];
 
 fn at(rows: &[Vec<f64>], lambda: f64) -> &Vec<f64> {
-    rows.iter().find(|r| (r[1] - lambda).abs() < 1e-9).unwrap_or_else(|| panic!("no row at lambda {lambda}"))
+    rows.iter()
+        .find(|r| (r[1] - lambda).abs() < 1e-9)
+        .unwrap_or_else(|| panic!("no row at lambda {lambda}"))
 }
 
 #[test]
@@ -27,8 +33,17 @@ fn default_mesh_is_within_one_percent_and_ranks_agree() {
     for &(lambda, u, v) in &REISSNER[1..] {
         let r = at(&runs[0], lambda);
         let (eu, ev) = ((r[2] - u) / u, (r[3] - v) / v);
-        println!("lambda {lambda}: u/L {:.5} ({:+.2} %), v/L {:.5} ({:+.2} %)", r[2], 100.0 * eu, r[3], 100.0 * ev);
-        assert!(eu.abs() < 0.01 && ev.abs() < 0.01, "lambda {lambda}: {r:?} vs ({u}, {v})");
+        println!(
+            "lambda {lambda}: u/L {:.5} ({:+.2} %), v/L {:.5} ({:+.2} %)",
+            r[2],
+            100.0 * eu,
+            r[3],
+            100.0 * ev
+        );
+        assert!(
+            eu.abs() < 0.01 && ev.abs() < 0.01,
+            "lambda {lambda}: {r:?} vs ({u}, {v})"
+        );
     }
     for (ranks, rows) in [(2, &runs[1]), (3, &runs[2])] {
         let mut worst: f64 = 0.0;

@@ -7,13 +7,19 @@ use common::*;
 use std::path::Path;
 
 fn fingerprints(dir: &Path, file: &str) -> Vec<String> {
-    [1, 2, 3].iter().map(|&n| ok(dir, n, &["mesh", file]).trim().to_string()).collect()
+    [1, 2, 3]
+        .iter()
+        .map(|&n| ok(dir, n, &["mesh", file]).trim().to_string())
+        .collect()
 }
 
 fn assert_same(what: &str, lines: &[String]) {
     println!("{what}: {}", lines[0]);
     assert!(lines[0].starts_with("fingerprint "), "{lines:?}");
-    assert!(lines.iter().all(|l| l == &lines[0]), "{what}: fingerprints differ between 1, 2, 3 ranks: {lines:#?}");
+    assert!(
+        lines.iter().all(|l| l == &lines[0]),
+        "{what}: fingerprints differ between 1, 2, 3 ranks: {lines:#?}"
+    );
 }
 
 fn count(line: &str, key: &str) -> u64 {
@@ -37,18 +43,48 @@ fn lattice_mesh_is_rank_count_independent() {
 #[test]
 fn random_cloud_mesh_is_rank_count_independent() {
     let dir = workdir("fp-random");
-    ok(&dir, 1, &["new", "cantilever", "-o", "j.h5", "--set", "body.jitter=0.45", "--set", "mesh.h=0.1"]);
+    ok(
+        &dir,
+        1,
+        &[
+            "new",
+            "cantilever",
+            "-o",
+            "j.h5",
+            "--set",
+            "body.jitter=0.45",
+            "--set",
+            "mesh.h=0.1",
+        ],
+    );
     assert_same("random cloud", &fingerprints(&dir, "j.h5"));
 }
 
 #[test]
 fn deformed_cloud_mesh_is_rank_count_independent() {
     let dir = workdir("fp-deformed");
-    ok(&dir, 1, &["new", "cantilever", "-o", "c.h5", "--set", "mesh.h=0.25", "--set", "steps.count=10"]);
+    ok(
+        &dir,
+        1,
+        &[
+            "new",
+            "cantilever",
+            "-o",
+            "c.h5",
+            "--set",
+            "mesh.h=0.25",
+            "--set",
+            "steps.count=10",
+        ],
+    );
     ok(&dir, 2, &["c.h5"]);
     let bent = "c.out/checkpoints/step_000010.h5";
     let lines = fingerprints(&dir, bent);
     assert_same("bent cantilever", &lines);
     let straight = ok(&dir, 1, &["mesh", "c.h5"]);
-    assert_ne!(straight.trim(), lines[0], "the bent beam must mesh differently from the straight one");
+    assert_ne!(
+        straight.trim(),
+        lines[0],
+        "the bent beam must mesh differently from the straight one"
+    );
 }

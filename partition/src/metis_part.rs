@@ -9,6 +9,7 @@ use crate::error::invalid;
 use crate::{Comm, PartitionError};
 
 /// METIS random seed: fixed so that the same graph always gets the same partition.
+static METIS_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
 const METIS_SEED: Idx = 20_240_601;
 
 /// Collective. Partition a distributed graph whose vertices are this rank's owned items (global
@@ -210,6 +211,9 @@ fn partition_gathered(
             *p = l as Idx;
         }
     } else {
+        // METIS keeps its random generator in process-global state: two threads partitioning at
+        // once (tests, or a threaded caller) would make each other's results differ.
+        let _serial = METIS_LOCK.lock().unwrap_or_else(|p| p.into_inner());
         Graph::new(1, parts_idx, &g.xadj, &g.adjncy)
             .map_err(|e| PartitionError::Metis(e.to_string()))?
             .set_option(metis::option::Seed(METIS_SEED))

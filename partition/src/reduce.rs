@@ -65,7 +65,9 @@ pub fn fetch_pairs(
                 slots[o].push(i);
             }
             None => {
-                local_err.get_or_insert_with(|| invalid(format!("fetch_pairs: request {i} names rank {owner}")));
+                local_err.get_or_insert_with(|| {
+                    invalid(format!("fetch_pairs: request {i} names rank {owner}"))
+                });
             }
         }
     }

@@ -54,7 +54,8 @@ impl LocalMesh {
         rank: i32,
         alpha: f64,
     ) -> Result<LocalMesh, MeshError> {
-        let all = delaunay(&points, &gids).map_err(|e| MeshError(format!("Delaunay triangulation failed: {e}")))?;
+        let all = delaunay(&points, &gids)
+            .map_err(|e| MeshError(format!("Delaunay triangulation failed: {e}")))?;
         let keep = alpha_keep(&points, &all, &h, alpha);
         let mut tris: Vec<[u32; 3]> = all
             .iter()
@@ -96,7 +97,11 @@ impl LocalMesh {
 
     /// Local index of each global id present on this rank.
     pub fn index_of(&self) -> HashMap<u64, u32> {
-        self.gids.iter().enumerate().map(|(i, &g)| (g, i as u32)).collect()
+        self.gids
+            .iter()
+            .enumerate()
+            .map(|(i, &g)| (g, i as u32))
+            .collect()
     }
 
     /// Number of owned triangles (for balance and the fingerprint).
@@ -106,7 +111,11 @@ impl LocalMesh {
 }
 
 fn key(t: &[u32; 3], gids: &[u64]) -> [u64; 3] {
-    [gids[t[0] as usize], gids[t[1] as usize], gids[t[2] as usize]]
+    [
+        gids[t[0] as usize],
+        gids[t[1] as usize],
+        gids[t[2] as usize],
+    ]
 }
 
 /// Rotates a CCW triangle so its smallest-gid vertex comes first; orientation is kept.

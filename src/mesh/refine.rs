@@ -12,8 +12,11 @@ pub struct RefineParams {
     pub split_length: f64,
     /// Remove a particle closer than this to a neighbour with a smaller global id.
     pub merge_distance: f64,
-    /// Move interior particles to the centroid of their neighbours.
+    /// Move interior particles to the centroid of their neighbours...
     pub smooth: bool,
+    /// ...when a triangle around them has an angle below this (radians): smoothing repairs bad
+    /// triangles and leaves a good cloud (a lattice) alone.
+    pub smooth_below_angle: f64,
 }
 
 impl Default for RefineParams {
@@ -22,6 +25,7 @@ impl Default for RefineParams {
             split_length: 1.6,
             merge_distance: 0.4,
             smooth: false,
+            smooth_below_angle: 25f64.to_radians(),
         }
     }
 }
@@ -75,6 +79,17 @@ pub fn plan(mesh: &LocalMesh, protected: impl Fn(usize) -> bool, params: &Refine
         .filter(|&&(_, _, a, b)| dist(a, b) > params.split_length * spacing(a, b))
         .map(|&(_, _, a, b)| [a, b])
         .collect();
+    let mut worst_angle = vec![std::f64::consts::PI; n];
+    if params.smooth {
+        for t in &mesh.tris {
+            let a = min_angle(t.map(|v| mesh.points[v as usize]));
+            for &v in t {
+                if (v as usize) < n {
+                    worst_angle[v as usize] = worst_angle[v as usize].min(a);
+                }
+            }
+        }
+    }
     let mut remove = Vec::new();
     let mut smooth = Vec::new();
     for (p, nb) in neighbours.iter_mut().enumerate() {
@@ -84,12 +99,16 @@ pub fn plan(mesh: &LocalMesh, protected: impl Fn(usize) -> bool, params: &Refine
             continue;
         }
         let pu = p as u32;
-        let close = nb
-            .iter()
-            .any(|&q| mesh.gids[q as usize] < mesh.gids[p] && dist(pu, q) < params.merge_distance * spacing(pu, q));
+        let close = nb.iter().any(|&q| {
+            mesh.gids[q as usize] < mesh.gids[p]
+                && dist(pu, q) < params.merge_distance * spacing(pu, q)
+        });
         if close {
             remove.push(pu);
-        } else if params.smooth && !mesh.on_boundary[p] {
+        } else if params.smooth
+            && !mesh.on_boundary[p]
+            && worst_angle[p] < params.smooth_below_angle
+        {
             let mut c = [0.0; 2];
             for &q in nb.iter() {
                 c[0] += mesh.points[q as usize][0];
@@ -102,7 +121,24 @@ pub fn plan(mesh: &LocalMesh, protected: impl Fn(usize) -> bool, params: &Refine
             }
         }
     }
-    Plan { split, remove, smooth }
+    Plan {
+        split,
+        remove,
+        smooth,
+    }
+}
+
+/// Smallest interior angle of a triangle (radians).
+pub fn min_angle(v: [[f64; 2]; 3]) -> f64 {
+    let mut best = std::f64::consts::PI;
+    for k in 0..3 {
+        let (o, a, b) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
+        let (u, w) = ([a[0] - o[0], a[1] - o[1]], [b[0] - o[0], b[1] - o[1]]);
+        let cross = (u[0] * w[1] - u[1] * w[0]).abs();
+        let dot = u[0] * w[0] + u[1] * w[1];
+        best = best.min(cross.atan2(dot));
+    }
+    best
 }
 
 fn dist_to(p: [f64; 2], q: [f64; 2]) -> f64 {
@@ -136,7 +172,12 @@ mod tests {
     #[test]
     fn close_pair_loses_the_larger_id_and_long_edges_split() {
         // Particle 8 (interior) pushed next to particle 7.
-        let m = lattice(5, 5, 1.0, |i| if i == 12 { [-0.7, 0.0] } else { [0.0, 0.0] });
+        let m = lattice(
+            5,
+            5,
+            1.0,
+            |i| if i == 12 { [-0.7, 0.0] } else { [0.0, 0.0] },
+        );
         let p = plan(&m, |_| false, &RefineParams::default());
         assert_eq!(p.remove, vec![12]);
         assert!(!p.split.is_empty(), "the gap left at x = 2 has long edges");
@@ -145,15 +186,44 @@ mod tests {
         }
     }
 
+    fn star_quality(m: &LocalMesh, p: u32, at: [f64; 2]) -> f64 {
+        m.tris
+            .iter()
+            .filter(|t| t.contains(&p))
+            .map(|t| min_angle(t.map(|v| if v == p { at } else { m.points[v as usize] })))
+            .fold(std::f64::consts::PI, f64::min)
+    }
+
     #[test]
-    fn smoothing_moves_only_interior_unprotected_particles() {
-        let m = lattice(5, 5, 1.0, |i| if i == 12 { [0.2, 0.1] } else { [0.0, 0.0] });
-        let params = RefineParams { smooth: true, ..Default::default() };
+    fn smoothing_repairs_bad_stars_and_leaves_a_lattice_alone() {
+        let params = RefineParams {
+            smooth: true,
+            ..Default::default()
+        };
+        let lattice = lattice(6, 5, 0.5, |_| [0.0, 0.0]);
+        assert!(plan(&lattice, |_| false, &params).is_empty());
+
+        let m = lattice_with(12, [0.58, 0.0]);
         let p = plan(&m, |_| false, &params);
         assert!(p.smooth.iter().all(|(i, _)| !m.on_boundary[*i as usize]));
-        let (_, target) = p.smooth.iter().find(|(i, _)| *i == 12).expect("12 is smoothed");
-        assert!(dist_to(*target, [2.0, 2.0]) < 0.1);
+        let (_, target) = p
+            .smooth
+            .iter()
+            .find(|(i, _)| *i == 12)
+            .expect("12 is smoothed");
+        let (before, after) = (
+            star_quality(&m, 12, m.points[12]),
+            star_quality(&m, 12, *target),
+        );
+        assert!(
+            after > before,
+            "smoothing must improve the worst angle: {before} -> {after}"
+        );
         let none = plan(&m, |i| i == 12, &params);
         assert!(none.smooth.iter().all(|(i, _)| *i != 12));
+    }
+
+    fn lattice_with(moved: usize, by: [f64; 2]) -> LocalMesh {
+        lattice(5, 5, 1.0, |i| if i == moved { by } else { [0.0, 0.0] })
     }
 }

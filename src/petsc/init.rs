@@ -37,7 +37,10 @@ impl Petsc {
             )?;
             // Errors come back as codes and are reported once by us, not as PETSc tracebacks.
             check(
-                ffi::PetscPushErrorHandler(Some(ffi::PetscReturnErrorHandler), std::ptr::null_mut()),
+                ffi::PetscPushErrorHandler(
+                    Some(ffi::PetscReturnErrorHandler),
+                    std::ptr::null_mut(),
+                ),
                 "PetscPushErrorHandler",
             )?;
         }
@@ -55,12 +58,21 @@ impl Petsc {
         // SAFETY: valid nul-terminated strings; null options database means the global one.
         unsafe {
             check(
-                ffi::PetscOptionsHasName(std::ptr::null_mut(), std::ptr::null(), cname.as_ptr(), &mut set),
+                ffi::PetscOptionsHasName(
+                    std::ptr::null_mut(),
+                    std::ptr::null(),
+                    cname.as_ptr(),
+                    &mut set,
+                ),
                 "PetscOptionsHasName",
             )?;
             if set == 0 {
                 check(
-                    ffi::PetscOptionsSetValue(std::ptr::null_mut(), cname.as_ptr(), cvalue.as_ptr()),
+                    ffi::PetscOptionsSetValue(
+                        std::ptr::null_mut(),
+                        cname.as_ptr(),
+                        cvalue.as_ptr(),
+                    ),
                     "PetscOptionsSetValue",
                 )?;
             }

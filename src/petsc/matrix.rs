@@ -13,23 +13,47 @@ impl Mat {
     /// per-row counts of nonzeros in the diagonal (`d_nnz`) and off-diagonal (`o_nnz`) blocks.
     /// Only owned rows may be set, and a value outside the preallocated pattern is an error: both
     /// catch a wrong sparsity pattern instead of silently slowing down.
-    pub fn aij(comm: &SimpleCommunicator, n_local: usize, d_nnz: &[i32], o_nnz: &[i32]) -> Result<Mat, PetscError> {
+    pub fn aij(
+        comm: &SimpleCommunicator,
+        n_local: usize,
+        d_nnz: &[i32],
+        o_nnz: &[i32],
+    ) -> Result<Mat, PetscError> {
         let mut raw: ffi::Mat = std::ptr::null_mut();
         let n = n_local as ffi::PetscInt;
         let det = ffi::PETSC_DETERMINE as ffi::PetscInt;
         // SAFETY: nnz arrays have n_local entries and are copied by PETSc.
         unsafe {
             check(
-                ffi::MatCreateAIJ(comm.as_raw(), n, n, det, det, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr(), &mut raw),
+                ffi::MatCreateAIJ(
+                    comm.as_raw(),
+                    n,
+                    n,
+                    det,
+                    det,
+                    0,
+                    d_nnz.as_ptr(),
+                    0,
+                    o_nnz.as_ptr(),
+                    &mut raw,
+                ),
                 "MatCreateAIJ",
             )?;
             let mat = Mat { raw };
             check(
-                ffi::MatSetOption(mat.raw, ffi::MatOption_MAT_NO_OFF_PROC_ENTRIES, ffi::PetscBool_PETSC_TRUE),
+                ffi::MatSetOption(
+                    mat.raw,
+                    ffi::MatOption_MAT_NO_OFF_PROC_ENTRIES,
+                    ffi::PetscBool_PETSC_TRUE,
+                ),
                 "MatSetOption(MAT_NO_OFF_PROC_ENTRIES)",
             )?;
             check(
-                ffi::MatSetOption(mat.raw, ffi::MatOption_MAT_NEW_NONZERO_ALLOCATION_ERR, ffi::PetscBool_PETSC_TRUE),
+                ffi::MatSetOption(
+                    mat.raw,
+                    ffi::MatOption_MAT_NEW_NONZERO_ALLOCATION_ERR,
+                    ffi::PetscBool_PETSC_TRUE,
+                ),
                 "MatSetOption(MAT_NEW_NONZERO_ALLOCATION_ERR)",
             )?;
             Ok(mat)
@@ -86,8 +110,14 @@ impl MatRef {
     pub fn assemble(&self) -> Result<(), PetscError> {
         // SAFETY: live matrix.
         unsafe {
-            check(ffi::MatAssemblyBegin(self.raw, ffi::MatAssemblyType_MAT_FINAL_ASSEMBLY), "MatAssemblyBegin")?;
-            check(ffi::MatAssemblyEnd(self.raw, ffi::MatAssemblyType_MAT_FINAL_ASSEMBLY), "MatAssemblyEnd")
+            check(
+                ffi::MatAssemblyBegin(self.raw, ffi::MatAssemblyType_MAT_FINAL_ASSEMBLY),
+                "MatAssemblyBegin",
+            )?;
+            check(
+                ffi::MatAssemblyEnd(self.raw, ffi::MatAssemblyType_MAT_FINAL_ASSEMBLY),
+                "MatAssemblyEnd",
+            )
         }
     }
 }

@@ -29,7 +29,13 @@ impl Scatter {
                 "ISCreateGeneral",
             )?;
             let made = check(
-                ffi::VecScatterCreate(template.raw, is_from, local.raw, std::ptr::null_mut(), &mut raw),
+                ffi::VecScatterCreate(
+                    template.raw,
+                    is_from,
+                    local.raw,
+                    std::ptr::null_mut(),
+                    &mut raw,
+                ),
                 "VecScatterCreate",
             );
             ffi::ISDestroy(&mut is_from);

@@ -69,35 +69,58 @@ impl Snes {
             let lu = cstring("lu")?;
             check(ffi::PCSetType(pc, lu.as_ptr()), "PCSetType")?;
             let mumps = cstring("mumps")?;
-            check(ffi::PCFactorSetMatSolverType(pc, mumps.as_ptr()), "PCFactorSetMatSolverType")?;
+            check(
+                ffi::PCFactorSetMatSolverType(pc, mumps.as_ptr()),
+                "PCFactorSetMatSolverType",
+            )?;
             // Full Newton steps: the large-rotation residual grows on the first iterate of a load
             // step before Newton's quadratic phase, and a backtracking search then crawls.
             let mut ls: ffi::SNESLineSearch = std::ptr::null_mut();
             check(ffi::SNESGetLineSearch(raw, &mut ls), "SNESGetLineSearch")?;
             let basic = cstring("basic")?;
-            check(ffi::SNESLineSearchSetType(ls, basic.as_ptr()), "SNESLineSearchSetType")?;
+            check(
+                ffi::SNESLineSearchSetType(ls, basic.as_ptr()),
+                "SNESLineSearchSetType",
+            )?;
             check(ffi::SNESSetFromOptions(raw), "SNESSetFromOptions")?;
             Ok(snes)
         }
     }
 
     /// Collective. Solves F(x) = 0 starting from `x`; `jac` holds the preallocated pattern.
-    pub fn solve(&mut self, problem: &mut dyn NonlinearProblem, x: &PVec, jac: &Mat) -> Result<SolveStats, PetscError> {
+    pub fn solve(
+        &mut self,
+        problem: &mut dyn NonlinearProblem,
+        x: &PVec,
+        jac: &Mat,
+    ) -> Result<SolveStats, PetscError> {
         let r = x.duplicate()?;
-        let mut ctx = Ctx { problem, error: None };
+        let mut ctx = Ctx {
+            problem,
+            error: None,
+        };
         let ctx_ptr = &mut ctx as *mut Ctx as *mut c_void;
         // SAFETY: ctx outlives SNESSolve, the only place the callbacks run; the callbacks catch
         // panics so none unwinds into C.
         let solved = unsafe {
-            check(ffi::SNESSetFunction(self.raw, r.raw, Some(residual_cb), ctx_ptr), "SNESSetFunction")?;
+            check(
+                ffi::SNESSetFunction(self.raw, r.raw, Some(residual_cb), ctx_ptr),
+                "SNESSetFunction",
+            )?;
             check(
                 ffi::SNESSetJacobian(self.raw, jac.raw, jac.raw, Some(jacobian_cb), ctx_ptr),
                 "SNESSetJacobian",
             )?;
-            check(ffi::SNESSolve(self.raw, std::ptr::null_mut(), x.raw), "SNESSolve")
+            check(
+                ffi::SNESSolve(self.raw, std::ptr::null_mut(), x.raw),
+                "SNESSolve",
+            )
         };
         if let Some(msg) = ctx.error.take() {
-            return Err(PetscError { code: PETSC_ERR_USER, message: msg });
+            return Err(PetscError {
+                code: PETSC_ERR_USER,
+                message: msg,
+            });
         }
         solved?;
         let mut reason: ffi::SNESConvergedReason = 0;
@@ -106,13 +129,28 @@ impl Snes {
         let mut norm = 0.0;
         // SAFETY: live SNES; the reason string is static in PETSc.
         unsafe {
-            check(ffi::SNESGetConvergedReason(self.raw, &mut reason), "SNESGetConvergedReason")?;
-            check(ffi::SNESGetIterationNumber(self.raw, &mut its), "SNESGetIterationNumber")?;
-            check(ffi::SNESGetLinearSolveIterations(self.raw, &mut lits), "SNESGetLinearSolveIterations")?;
-            check(ffi::SNESGetFunctionNorm(self.raw, &mut norm), "SNESGetFunctionNorm")?;
+            check(
+                ffi::SNESGetConvergedReason(self.raw, &mut reason),
+                "SNESGetConvergedReason",
+            )?;
+            check(
+                ffi::SNESGetIterationNumber(self.raw, &mut its),
+                "SNESGetIterationNumber",
+            )?;
+            check(
+                ffi::SNESGetLinearSolveIterations(self.raw, &mut lits),
+                "SNESGetLinearSolveIterations",
+            )?;
+            check(
+                ffi::SNESGetFunctionNorm(self.raw, &mut norm),
+                "SNESGetFunctionNorm",
+            )?;
             if reason < 0 {
                 let mut text: *const std::os::raw::c_char = std::ptr::null();
-                check(ffi::SNESGetConvergedReasonString(self.raw, &mut text), "SNESGetConvergedReasonString")?;
+                check(
+                    ffi::SNESGetConvergedReasonString(self.raw, &mut text),
+                    "SNESGetConvergedReasonString",
+                )?;
                 let why = if text.is_null() {
                     format!("reason {reason}")
                 } else {
@@ -141,7 +179,11 @@ impl Drop for Snes {
     }
 }
 
-fn report(snes: ffi::SNES, ctx: &mut Ctx, outcome: std::thread::Result<Result<(), CallbackError>>) -> ffi::PetscErrorCode {
+fn report(
+    snes: ffi::SNES,
+    ctx: &mut Ctx,
+    outcome: std::thread::Result<Result<(), CallbackError>>,
+) -> ffi::PetscErrorCode {
     match outcome {
         Ok(Ok(())) => 0,
         Ok(Err(CallbackError::Domain(msg))) => {
@@ -154,7 +196,11 @@ fn report(snes: ffi::SNES, ctx: &mut Ctx, outcome: std::thread::Result<Result<()
             PETSC_ERR_USER
         }
         Err(_) => {
-            ctx_note(ctx, Some(()), "internal error: a panic in the residual or Jacobian");
+            ctx_note(
+                ctx,
+                Some(()),
+                "internal error: a panic in the residual or Jacobian",
+            );
             PETSC_ERR_USER
         }
     }
@@ -166,10 +212,17 @@ fn ctx_note(ctx: &mut Ctx, fatal: Option<()>, msg: &str) {
     }
 }
 
-unsafe extern "C" fn residual_cb(snes: ffi::SNES, x: ffi::Vec, f: ffi::Vec, ctx: *mut c_void) -> ffi::PetscErrorCode {
+unsafe extern "C" fn residual_cb(
+    snes: ffi::SNES,
+    x: ffi::Vec,
+    f: ffi::Vec,
+    ctx: *mut c_void,
+) -> ffi::PetscErrorCode {
     // SAFETY: ctx is the `Ctx` that `Snes::solve` keeps alive during SNESSolve.
     let ctx = unsafe { &mut *(ctx as *mut Ctx) };
-    let outcome = catch_unwind(AssertUnwindSafe(|| ctx.problem.residual(VecRef { raw: x }, VecRef { raw: f })));
+    let outcome = catch_unwind(AssertUnwindSafe(|| {
+        ctx.problem.residual(VecRef { raw: x }, VecRef { raw: f })
+    }));
     report(snes, ctx, outcome)
 }
 
@@ -182,6 +235,8 @@ unsafe extern "C" fn jacobian_cb(
 ) -> ffi::PetscErrorCode {
     // SAFETY: as in `residual_cb`.
     let ctx = unsafe { &mut *(ctx as *mut Ctx) };
-    let outcome = catch_unwind(AssertUnwindSafe(|| ctx.problem.jacobian(VecRef { raw: x }, MatRef { raw: j })));
+    let outcome = catch_unwind(AssertUnwindSafe(|| {
+        ctx.problem.jacobian(VecRef { raw: x }, MatRef { raw: j })
+    }));
     report(snes, ctx, outcome)
 }

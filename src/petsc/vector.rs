@@ -21,7 +21,12 @@ impl PVec {
         // SAFETY: out-pointer to a fresh handle.
         check(
             unsafe {
-                ffi::VecCreateMPI(comm.as_raw(), n_local as ffi::PetscInt, ffi::PETSC_DETERMINE as ffi::PetscInt, &mut raw)
+                ffi::VecCreateMPI(
+                    comm.as_raw(),
+                    n_local as ffi::PetscInt,
+                    ffi::PETSC_DETERMINE as ffi::PetscInt,
+                    &mut raw,
+                )
             },
             "VecCreateMPI",
         )?;
@@ -43,7 +48,10 @@ impl PVec {
     pub fn duplicate(&self) -> Result<PVec, PetscError> {
         let mut raw: ffi::Vec = std::ptr::null_mut();
         // SAFETY: self.raw is a live vector.
-        check(unsafe { ffi::VecDuplicate(self.raw, &mut raw) }, "VecDuplicate")?;
+        check(
+            unsafe { ffi::VecDuplicate(self.raw, &mut raw) },
+            "VecDuplicate",
+        )?;
         Ok(PVec { raw })
     }
 
@@ -67,10 +75,20 @@ impl VecRef {
         let n = self.local_size()?;
         let mut ptr: *const f64 = std::ptr::null();
         // SAFETY: PETSc hands out the local array until the matching restore call.
-        check(unsafe { ffi::VecGetArrayRead(self.raw, &mut ptr) }, "VecGetArrayRead")?;
-        let slice = if n == 0 { &[][..] } else { unsafe { std::slice::from_raw_parts(ptr, n) } };
+        check(
+            unsafe { ffi::VecGetArrayRead(self.raw, &mut ptr) },
+            "VecGetArrayRead",
+        )?;
+        let slice = if n == 0 {
+            &[][..]
+        } else {
+            unsafe { std::slice::from_raw_parts(ptr, n) }
+        };
         let out = f(slice);
-        check(unsafe { ffi::VecRestoreArrayRead(self.raw, &mut ptr) }, "VecRestoreArrayRead")?;
+        check(
+            unsafe { ffi::VecRestoreArrayRead(self.raw, &mut ptr) },
+            "VecRestoreArrayRead",
+        )?;
         Ok(out)
     }
 
@@ -79,17 +97,30 @@ impl VecRef {
         let n = self.local_size()?;
         let mut ptr: *mut f64 = std::ptr::null_mut();
         // SAFETY: as in `read`; no other borrow of this array exists while `f` runs.
-        check(unsafe { ffi::VecGetArray(self.raw, &mut ptr) }, "VecGetArray")?;
-        let slice = if n == 0 { &mut [][..] } else { unsafe { std::slice::from_raw_parts_mut(ptr, n) } };
+        check(
+            unsafe { ffi::VecGetArray(self.raw, &mut ptr) },
+            "VecGetArray",
+        )?;
+        let slice = if n == 0 {
+            &mut [][..]
+        } else {
+            unsafe { std::slice::from_raw_parts_mut(ptr, n) }
+        };
         let out = f(slice);
-        check(unsafe { ffi::VecRestoreArray(self.raw, &mut ptr) }, "VecRestoreArray")?;
+        check(
+            unsafe { ffi::VecRestoreArray(self.raw, &mut ptr) },
+            "VecRestoreArray",
+        )?;
         Ok(out)
     }
 
     pub fn local_size(&self) -> Result<usize, PetscError> {
         let mut n: ffi::PetscInt = 0;
         // SAFETY: live vector.
-        check(unsafe { ffi::VecGetLocalSize(self.raw, &mut n) }, "VecGetLocalSize")?;
+        check(
+            unsafe { ffi::VecGetLocalSize(self.raw, &mut n) },
+            "VecGetLocalSize",
+        )?;
         Ok(n as usize)
     }
 
@@ -97,7 +128,10 @@ impl VecRef {
     pub fn ownership_start(&self) -> Result<usize, PetscError> {
         let (mut lo, mut hi): (ffi::PetscInt, ffi::PetscInt) = (0, 0);
         // SAFETY: live vector.
-        check(unsafe { ffi::VecGetOwnershipRange(self.raw, &mut lo, &mut hi) }, "VecGetOwnershipRange")?;
+        check(
+            unsafe { ffi::VecGetOwnershipRange(self.raw, &mut lo, &mut hi) },
+            "VecGetOwnershipRange",
+        )?;
         Ok(lo as usize)
     }
 
@@ -105,7 +139,10 @@ impl VecRef {
     pub fn norm2(&self) -> Result<f64, PetscError> {
         let mut v = 0.0;
         // SAFETY: live vector.
-        check(unsafe { ffi::VecNorm(self.raw, ffi::NormType_NORM_2, &mut v) }, "VecNorm")?;
+        check(
+            unsafe { ffi::VecNorm(self.raw, ffi::NormType_NORM_2, &mut v) },
+            "VecNorm",
+        )?;
         Ok(v)
     }
 }

@@ -24,7 +24,9 @@ pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), String>
     let mut sim = Simulation::load(world, &opts.case)?;
     let mut out = simulation::Output::open(world, &sim, &opts.out_dir)?;
     let mut progress = Progress::new(world, sim.total_steps());
-    let last = opts.until_step.map_or(sim.total_steps(), |k| k.min(sim.total_steps()));
+    let last = opts
+        .until_step
+        .map_or(sim.total_steps(), |k| k.min(sim.total_steps()));
     while sim.step() < last {
         let mut t = PhaseTimer::default();
         let mesh = t.time("remesh", || sim.remesh(world))?;

@@ -44,12 +44,17 @@ impl Progress {
 
     pub fn step(&mut self, sim: &Simulation, r: &StepReport, t: &PhaseTimer) {
         let step = sim.step();
-        if !self.root || (step % self.every != 0 && step != self.total) {
+        if !self.root || (!step.is_multiple_of(self.every) && step != self.total) {
             return;
         }
-        let phases: Vec<String> = t.phases.iter().map(|(n, s)| format!("{n} {s:.3}")).collect();
+        let phases: Vec<String> = t
+            .phases
+            .iter()
+            .map(|(n, s)| format!("{n} {s:.3}"))
+            .collect();
         let done = step.saturating_sub(sim.first_step()) as f64;
-        let left = (self.total - step) as f64 * self.started.elapsed().as_secs_f64() / done.max(1.0);
+        let left =
+            (self.total - step) as f64 * self.started.elapsed().as_secs_f64() / done.max(1.0);
         println!(
             "step {step:>5}/{} load {:.4} newton {:>2} |R| {:.2e} particles {} triangles {} | {} | step {:.3}s left {:.0}s",
             self.total,
@@ -66,7 +71,11 @@ impl Progress {
 
     pub fn finish(&self, sim: &Simulation) {
         if self.root {
-            println!("done: step {} in {:.2} s", sim.step(), self.started.elapsed().as_secs_f64());
+            println!(
+                "done: step {} in {:.2} s",
+                sim.step(),
+                self.started.elapsed().as_secs_f64()
+            );
         }
     }
 }

@@ -27,20 +27,39 @@ impl Simulation {
         let protected = |p: usize| {
             self.particles.flags[p] & flag::TRACKED != 0
                 || mesh.on_boundary[p]
-                || self.model.step_bc(self.particles.reference_position(p)).iter().any(Option::is_some)
+                || self
+                    .model
+                    .step_bc(self.particles.reference_position(p))
+                    .iter()
+                    .any(Option::is_some)
         };
         let mut plan = plan(mesh, protected, &params);
         if !settings.refine {
             plan.split.clear();
             plan.remove.clear();
         }
-        let changes = sum_f64(world, &[(plan.split.len() + plan.remove.len() + plan.smooth.len()) as f64])[0];
+        let changes = sum_f64(
+            world,
+            &[(plan.split.len() + plan.remove.len() + plan.smooth.len()) as f64],
+        )[0];
         if changes == 0.0 {
             return Ok(false);
         }
         let n = mesh.n_owned;
-        let value = |p: usize| if p < n { self.particles.state[p] } else { self.ghosts.state[p - n] };
-        let disp = |p: usize| if p < n { self.particles.displacement[p] } else { self.ghosts.displacement[p - n] };
+        let value = |p: usize| {
+            if p < n {
+                self.particles.state[p]
+            } else {
+                self.ghosts.state[p - n]
+            }
+        };
+        let disp = |p: usize| {
+            if p < n {
+                self.particles.displacement[p]
+            } else {
+                self.ghosts.displacement[p - n]
+            }
+        };
 
         // Smoothed particles take the old field's values at their new place.
         let mut moved = HashSet::new();
@@ -52,8 +71,15 @@ impl Simulation {
             }
         }
         // New particles at edge midpoints; ids by the global sorted order of their edges.
-        let keys: Vec<u64> = plan.split.iter().flat_map(|[a, b]| [mesh.gids[*a as usize], mesh.gids[*b as usize]]).collect();
-        let mut all: Vec<[u64; 2]> = allgather_u64(world, &keys).chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+        let keys: Vec<u64> = plan
+            .split
+            .iter()
+            .flat_map(|[a, b]| [mesh.gids[*a as usize], mesh.gids[*b as usize]])
+            .collect();
+        let mut all: Vec<[u64; 2]> = allgather_u64(world, &keys)
+            .chunks_exact(2)
+            .map(|c| [c[0], c[1]])
+            .collect();
         all.sort_unstable();
         let first_new = self.header.next_gid;
         self.header.next_gid += all.len() as u64;
@@ -64,7 +90,9 @@ impl Simulation {
             let (a, b) = (*a as usize, *b as usize);
             let key = [mesh.gids[a], mesh.gids[b]];
             let Ok(rank) = all.binary_search(&key) else {
-                return Err(format!("refinement: edge {key:?} missing from the global list"));
+                return Err(format!(
+                    "refinement: edge {key:?} missing from the global list"
+                ));
             };
             let (sa, sb) = (value(a), value(b));
             let state: [f64; K] = std::array::from_fn(|k| 0.5 * (sa[k] + sb[k]));

@@ -52,7 +52,8 @@ impl Simulation {
     /// Collective. Reads a case or checkpoint on any rank count and partitions it with METIS.
     pub fn load(world: &Comm, path: &Path) -> Result<Simulation, String> {
         let (header, set) = read_case(world, path).map_err(err)?;
-        let scene = Scene::from_toml(&header.scene_toml, &path.display().to_string(), &[]).map_err(|e| e.to_string())?;
+        let scene = Scene::from_toml(&header.scene_toml, &path.display().to_string(), &[])
+            .map_err(|e| e.to_string())?;
         let model = Model::new(&scene).map_err(|e| format!("{}: {e}", path.display()))?;
         let mut particles = Particles {
             gid: set.gid,
@@ -125,14 +126,31 @@ impl Simulation {
         let rank = world.rank();
         let points = p.position.iter().chain(&g.position).copied().collect();
         let gids = p.gid.iter().chain(&g.gid).copied().collect();
-        let owner = std::iter::repeat_n(rank, p.len()).chain(g.owner.iter().copied()).collect();
+        let owner = std::iter::repeat_n(rank, p.len())
+            .chain(g.owner.iter().copied())
+            .collect();
         let h: Vec<f64> = p.h.iter().chain(&g.h).copied().collect();
-        LocalMesh::build(points, gids, owner, h, p.len(), rank, self.model.scene.mesh.alpha).map_err(err)
+        LocalMesh::build(
+            points,
+            gids,
+            owner,
+            h,
+            p.len(),
+            rank,
+            self.model.scene.mesh.alpha,
+        )
+        .map_err(err)
     }
 
     /// Start-of-step Gauss states on the new mesh (rank-local).
     pub fn map(&self, mesh: &LocalMesh) -> Vec<[GaussState; 3]> {
-        let at_points: Vec<[f64; GaussState::LEN]> = self.particles.state.iter().chain(&self.ghosts.state).copied().collect();
+        let at_points: Vec<[f64; GaussState::LEN]> = self
+            .particles
+            .state
+            .iter()
+            .chain(&self.ghosts.state)
+            .copied()
+            .collect();
         map_states(&self.tri_states, mesh, &at_points).0
     }
 
@@ -147,14 +165,28 @@ impl Simulation {
     }
 
     /// Collective. One implicit updated-Lagrangian increment by Newton (PETSc SNES).
-    pub fn solve(&self, world: &Comm, petsc: &Petsc, mesh: &LocalMesh, states_n: &[[GaussState; 3]]) -> Result<Solved, String> {
+    pub fn solve(
+        &self,
+        world: &Comm,
+        petsc: &Petsc,
+        mesh: &LocalMesh,
+        states_n: &[[GaussState; 3]],
+    ) -> Result<Solved, String> {
         let _ = petsc;
         let step = self.header.step + 1;
         let dofs = DofMap::build(world, mesh).map_err(err)?;
-        let constraints = Constraints::build(&dofs, |p| self.model.step_bc(self.reference_position(mesh, p)));
+        let constraints = Constraints::build(&dofs, |p| {
+            self.model.step_bc(self.reference_position(mesh, p))
+        });
         let factor = self.model.load_factor(step);
         let mut point_loads = Vec::new();
-        for (load, &gid) in self.model.scene.point_load.iter().zip(&self.header.tracked_gids) {
+        for (load, &gid) in self
+            .model
+            .scene
+            .point_load
+            .iter()
+            .zip(&self.header.tracked_gids)
+        {
             if let Ok(i) = self.particles.gid.binary_search(&gid) {
                 let node = dofs.node_of_point[i];
                 if node != u32::MAX {
@@ -175,7 +207,8 @@ impl Simulation {
         let mut problem = StepProblem::new(world, mesh, &dofs, setup, &x).map_err(err)?;
         problem.initial_guess(&x).map_err(err)?;
         let solver = &self.model.scene.solver;
-        let mut snes = Snes::new(world, solver.newton_rtol, solver.newton_max_it as usize).map_err(err)?;
+        let mut snes =
+            Snes::new(world, solver.newton_rtol, solver.newton_max_it as usize).map_err(err)?;
         let stats = snes
             .solve(&mut problem, &x, &jac)
             .map_err(|e| format!("step {step}: {}", e.message))?;
@@ -197,14 +230,19 @@ impl Simulation {
     }
 
     /// Collective. Moves the particles and carries the new Gauss states to them.
-    pub fn update(&mut self, world: &Comm, mesh: &LocalMesh, solved: Solved) -> Result<StepReport, String> {
+    pub fn update(
+        &mut self,
+        world: &Comm,
+        mesh: &LocalMesh,
+        solved: Solved,
+    ) -> Result<StepReport, String> {
         for i in 0..self.particles.len() {
             let node = solved.dofs.node_of_point[i];
             if node != u32::MAX {
                 let d = solved.du[node as usize];
-                for c in 0..2 {
-                    self.particles.position[i][c] += d[c];
-                    self.particles.displacement[i][c] += d[c];
+                for (c, dc) in d.iter().enumerate() {
+                    self.particles.position[i][c] += dc;
+                    self.particles.displacement[i][c] += dc;
                 }
             }
         }
@@ -212,7 +250,10 @@ impl Simulation {
         self.tri_states = TriStates::new(mesh, solved.states);
         self.header.step += 1;
         self.header.load_factor = self.model.load_factor(self.header.step);
-        let counts = sum_f64(world, &[self.particles.len() as f64, mesh.n_owned_tris() as f64]);
+        let counts = sum_f64(
+            world,
+            &[self.particles.len() as f64, mesh.n_owned_tris() as f64],
+        );
         Ok(StepReport {
             newton_iterations: solved.newton_iterations,
             residual_norm: solved.residual_norm,
@@ -271,8 +312,17 @@ impl Simulation {
         }
         let dest = partition_graph(world, &self.particles.gid, &xadj, &adjncy).map_err(err)?;
         let flags: Vec<u64> = self.particles.flags.iter().map(|&f| f as u64).collect();
-        let (gid, rec, fl) = migrate(world, &dest, &self.particles.gid, &self.particles.records(), crate::particles::RECORD, &flags, 1);
-        self.particles = Particles::from_records(gid, &rec, fl.into_iter().map(|f| f as u32).collect());
+        let (gid, rec, fl) = migrate(
+            world,
+            &dest,
+            &self.particles.gid,
+            &self.particles.records(),
+            crate::particles::RECORD,
+            &flags,
+            1,
+        );
+        self.particles =
+            Particles::from_records(gid, &rec, fl.into_iter().map(|f| f as u32).collect());
         self.tri_states = TriStates::default();
         Ok(())
     }
@@ -319,7 +369,10 @@ impl Output {
         if let Some(e) = pfem_partition::agree_on_error(world, local) {
             return Err(e);
         }
-        Ok(Output { dir: dir.to_path_buf(), history })
+        Ok(Output {
+            dir: dir.to_path_buf(),
+            history,
+        })
     }
 
     /// Collective. Appends the step's row.
@@ -338,16 +391,27 @@ impl Output {
     }
 
     /// Collective. Checkpoint every K steps (scene setting) and at the last step of the run.
-    pub fn checkpoint_if_due(&mut self, world: &Comm, sim: &Simulation, last: u64) -> Result<(), String> {
+    pub fn checkpoint_if_due(
+        &mut self,
+        world: &Comm,
+        sim: &Simulation,
+        last: u64,
+    ) -> Result<(), String> {
         let every = sim.scene().output.checkpoint_every as u64;
         let step = sim.step();
-        if step != last && (every == 0 || step % every != 0) {
+        if step != last && (every == 0 || !step.is_multiple_of(every)) {
             return Ok(());
         }
-        let path = self.dir.join("checkpoints").join(format!("step_{step:06}.h5"));
+        let path = self
+            .dir
+            .join("checkpoints")
+            .join(format!("step_{step:06}.h5"));
         sim.write_checkpoint(world, &path)?;
         if world.rank() == 0 {
-            prune_checkpoints(&self.dir.join("checkpoints"), sim.scene().output.checkpoint_keep as usize);
+            prune_checkpoints(
+                &self.dir.join("checkpoints"),
+                sim.scene().output.checkpoint_keep as usize,
+            );
         }
         Ok(())
     }
@@ -355,10 +419,16 @@ impl Output {
 
 /// Keeps the newest `keep` checkpoints.
 fn prune_checkpoints(dir: &Path, keep: usize) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
     let mut names: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("step_") && n.ends_with(".h5")))
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("step_") && n.ends_with(".h5"))
+        })
         .collect();
     names.sort();
     let n = names.len();
@@ -373,7 +443,13 @@ fn prune_checkpoints(dir: &Path, keep: usize) {
 fn check_halo(world: &Comm, p: &Particles, g: &Ghosts, width: f64) -> Result<(), String> {
     use pfem_partition::allgather_u64;
     let mine: Vec<u64> = (0..p.len())
-        .flat_map(|i| [p.gid[i], p.position[i][0].to_bits(), p.position[i][1].to_bits()])
+        .flat_map(|i| {
+            [
+                p.gid[i],
+                p.position[i][0].to_bits(),
+                p.position[i][1].to_bits(),
+            ]
+        })
         .collect();
     let all = allgather_u64(world, &mine);
     let present: std::collections::HashSet<u64> = p.gid.iter().chain(&g.gid).copied().collect();

@@ -82,7 +82,10 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
 
     let jitter = s.body.jitter;
     if !(0.0..0.5).contains(&jitter) {
-        return fail(root.join("body").join("jitter"), format!("must be in [0, 0.5) (got {jitter})"));
+        return fail(
+            root.join("body").join("jitter"),
+            format!("must be in [0, 0.5) (got {jitter})"),
+        );
     }
 
     let mesh = root.join("mesh");

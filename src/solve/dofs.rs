@@ -60,7 +60,11 @@ impl DofMap {
             for k in 0..3 {
                 nodes[k] = node_of_point[t[k] as usize];
                 let (a, b) = (t[k], t[(k + 1) % 3]);
-                let e = if mesh.gids[a as usize] < mesh.gids[b as usize] { (a, b) } else { (b, a) };
+                let e = if mesh.gids[a as usize] < mesh.gids[b as usize] {
+                    (a, b)
+                } else {
+                    (b, a)
+                };
                 let next = edges.len() as u32;
                 let idx = *edge_index.entry(e).or_insert_with(|| {
                     edges.push([e.0, e.1]);
@@ -108,7 +112,11 @@ impl DofMap {
         let mut asked = Vec::new();
         for (n, &own) in node_owned.iter().enumerate() {
             if !own {
-                let owner_point = if node_point[n] != u32::MAX { node_point[n] } else { sorted_edges[n - n_vertex_nodes as usize][0] };
+                let owner_point = if node_point[n] != u32::MAX {
+                    node_point[n]
+                } else {
+                    sorted_edges[n - n_vertex_nodes as usize][0]
+                };
                 requests.push((mesh.owner[owner_point as usize], keys[n]));
                 asked.push(n);
             }

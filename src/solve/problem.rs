@@ -46,7 +46,13 @@ impl<'a> StepProblem<'a> {
         let geometry = mesh
             .tris
             .iter()
-            .map(|t| straight_sided(&[mesh.points[t[0] as usize], mesh.points[t[1] as usize], mesh.points[t[2] as usize]]))
+            .map(|t| {
+                straight_sided(&[
+                    mesh.points[t[0] as usize],
+                    mesh.points[t[1] as usize],
+                    mesh.points[t[2] as usize],
+                ])
+            })
             .collect();
         Ok(StepProblem {
             comm,
@@ -63,7 +69,14 @@ impl<'a> StepProblem<'a> {
         let first = self.dofs.first_dof;
         x.as_ref().write(|xa| {
             xa.fill(0.0);
-            for (n, f) in self.dofs.node_owned.iter().zip(&self.setup.constraints.fixed).enumerate().filter_map(|(n, (&o, f))| o.then_some((n, f))) {
+            for (n, f) in self
+                .dofs
+                .node_owned
+                .iter()
+                .zip(&self.setup.constraints.fixed)
+                .enumerate()
+                .filter_map(|(n, (&o, f))| o.then_some((n, f)))
+            {
                 for c in 0..2 {
                     if let Some(g) = f[c] {
                         xa[self.dofs.node_global[n] - first + c] = g;
@@ -75,7 +88,8 @@ impl<'a> StepProblem<'a> {
 
     /// Collective. Step displacement of every local node (owned and ghost), from the solution.
     pub fn local_displacements(&self, x: VecRef) -> Result<Vec<[f64; 2]>, PetscError> {
-        self.scatter.gather(x, |l| l.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+        self.scatter
+            .gather(x, |l| l.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
     }
 
     /// Evaluates every local triangle at step displacement `du` (local node order).
@@ -86,8 +100,14 @@ impl<'a> StepProblem<'a> {
             for (k, &n) in nodes.iter().enumerate() {
                 d[k] = du[n as usize];
             }
-            let e = p2_element(&self.geometry[t], &d, &self.setup.states_n[t], self.setup.material, self.setup.body_force)
-                .map_err(|e| format!("triangle {:?}: {e}", self.mesh.tri_key(t)))?;
+            let e = p2_element(
+                &self.geometry[t],
+                &d,
+                &self.setup.states_n[t],
+                self.setup.material,
+                self.setup.body_force,
+            )
+            .map_err(|e| format!("triangle {:?}: {e}", self.mesh.tri_key(t)))?;
             out.push(e);
         }
         Ok(out)
@@ -95,7 +115,9 @@ impl<'a> StepProblem<'a> {
 
     /// Collective: all ranks learn whether any element failed, so they fail together.
     fn evaluate(&self, x: VecRef) -> Result<Vec<ElementOutput>, CallbackError> {
-        let du = self.local_displacements(x).map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        let du = self
+            .local_displacements(x)
+            .map_err(|e| CallbackError::Fatal(e.to_string()))?;
         let local = self.elements(&du);
         let err = local.as_ref().err().cloned();
         match agree_on_error(self.comm, err) {
@@ -106,14 +128,17 @@ impl<'a> StepProblem<'a> {
 
     fn owned_row(&self, node: u32, c: usize) -> Option<usize> {
         let n = node as usize;
-        (self.dofs.node_owned[n] && self.setup.constraints.fixed[n][c].is_none()).then(|| self.dofs.node_global[n] - self.dofs.first_dof + c)
+        (self.dofs.node_owned[n] && self.setup.constraints.fixed[n][c].is_none())
+            .then(|| self.dofs.node_global[n] - self.dofs.first_dof + c)
     }
 }
 
 impl NonlinearProblem for StepProblem<'_> {
     fn residual(&mut self, x: VecRef, f: VecRef) -> Result<(), CallbackError> {
         let elems = self.evaluate(x)?;
-        let xs: Vec<f64> = x.read(|a| a.to_vec()).map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        let xs: Vec<f64> = x
+            .read(|a| a.to_vec())
+            .map_err(|e| CallbackError::Fatal(e.to_string()))?;
         f.write(|fa| {
             fa.fill(0.0);
             for (nodes, e) in self.dofs.tri_nodes.iter().zip(&elems) {
@@ -155,10 +180,13 @@ impl NonlinearProblem for StepProblem<'_> {
         let mut row_k = Vec::with_capacity(N_DOFS);
         let mut vals = Vec::with_capacity(N_DOFS * N_DOFS);
         for (nodes, e) in self.dofs.tri_nodes.iter().zip(&elems) {
-            let cols: Vec<i32> = nodes.iter().flat_map(|&n| {
-                let g = self.dofs.node_global[n as usize] as i32;
-                [g, g + 1]
-            }).collect();
+            let cols: Vec<i32> = nodes
+                .iter()
+                .flat_map(|&n| {
+                    let g = self.dofs.node_global[n as usize] as i32;
+                    [g, g + 1]
+                })
+                .collect();
             rows.clear();
             row_k.clear();
             for (k, &n) in nodes.iter().enumerate() {
