@@ -131,3 +131,87 @@ pub fn recover_at_particles(
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A square lattice meshed twice with different global ids, so SoS picks other diagonals.
+    fn meshes(n: usize, h: f64) -> (LocalMesh, LocalMesh) {
+        let mut pts = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                pts.push([i as f64 * h, j as f64 * h]);
+            }
+        }
+        let np = pts.len();
+        let build = |gids: Vec<u64>| {
+            LocalMesh::build(pts.clone(), gids, vec![0; np], vec![h; np], np, 0, 1.3).unwrap()
+        };
+        (
+            build((0..np as u64).collect()),
+            build((0..np as u64).rev().collect()),
+        )
+    }
+
+    fn states_of(mesh: &LocalMesh, f: &impl Fn([f64; 2]) -> f64) -> Vec<[GaussState; 3]> {
+        (0..mesh.tris.len())
+            .map(|t| {
+                let v = mesh.tris[t].map(|i| mesh.points[i as usize]);
+                p2_gauss_points(&straight_sided(&v)).map(|p| {
+                    let mut a = [0.0; K];
+                    for (k, x) in a.iter_mut().enumerate() {
+                        *x = f(p) * (k + 1) as f64;
+                    }
+                    GaussState::from_array(&a)
+                })
+            })
+            .collect()
+    }
+
+    /// Largest error at the new mesh's Gauss points after Gauss -> particle -> Gauss.
+    fn round_trip_error(n: usize, f: impl Fn([f64; 2]) -> f64) -> f64 {
+        let h = 1.0 / n as f64;
+        let (a, b) = meshes(n, h);
+        let at_particles = recover_at_particles(&a, &states_of(&a, &f), &vec![[0.0; K]; a.n_owned]);
+        // Mesh b numbers the same points in reverse: its particle values are a's, reversed.
+        let on_b: Vec<[f64; K]> = (0..b.points.len()).map(|i| at_particles[i]).collect();
+        let (mapped, stats) = map_states(&TriStates::default(), &b, &on_b);
+        assert_eq!(stats.kept, 0);
+        let exact = states_of(&b, &f);
+        let mut worst: f64 = 0.0;
+        for (m, e) in mapped.iter().zip(&exact) {
+            for q in 0..3 {
+                for (x, y) in m[q].to_array().iter().zip(e[q].to_array()) {
+                    worst = worst.max((x - y).abs());
+                }
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn linear_fields_are_reproduced_exactly() {
+        let err = round_trip_error(6, |p| 3.0 + 2.0 * p[0] - 5.0 * p[1]);
+        assert!(err < 1e-12, "linear field changed by {err}");
+    }
+
+    #[test]
+    fn smoothing_of_a_curved_field_is_second_order() {
+        let f = |p: [f64; 2]| (3.0 * p[0]).sin() * (2.0 * p[1]).cos();
+        let (e1, e2) = (round_trip_error(8, f), round_trip_error(16, f));
+        println!("Gauss -> particle -> Gauss error of sin(3x)cos(2y) (x 1..9 per component): h=1/8 {e1:.2e}, h=1/16 {e2:.2e}");
+        assert!(e1 < 0.05 * 9.0, "{e1}");
+        assert!(e2 < e1 / 3.0, "not second order: {e1} -> {e2}");
+    }
+
+    #[test]
+    fn unchanged_triangles_keep_their_states() {
+        let (a, _) = meshes(4, 0.25);
+        let states = states_of(&a, &|p| p[0] * p[0]);
+        let old = TriStates::new(&a, states.clone());
+        let (mapped, stats) = map_states(&old, &a, &vec![[0.0; K]; a.points.len()]);
+        assert_eq!(stats.interpolated, 0);
+        assert_eq!(mapped, states);
+    }
+}

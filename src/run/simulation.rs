@@ -151,7 +151,13 @@ impl Simulation {
             .chain(&self.ghosts.state)
             .copied()
             .collect();
-        map_states(&self.tri_states, mesh, &at_points).0
+        let none = TriStates::default();
+        let old = if self.model.scene.mesh.remap_all {
+            &none
+        } else {
+            &self.tri_states
+        };
+        map_states(old, mesh, &at_points).0
     }
 
     pub(super) fn reference_position(&self, mesh: &LocalMesh, p: usize) -> [f64; 2] {

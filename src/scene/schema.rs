@@ -78,6 +78,11 @@ pub struct Mesh {
     /// Laplacian smoothing of interior particles after remeshing. Default false.
     #[serde(default)]
     pub smooth: bool,
+    /// Map every triangle's state through the particles after every remesh, as Abaqus' mesh-to-
+    /// mesh solution mapping does, instead of keeping the Gauss states of triangles the remesh
+    /// left unchanged. For studying the cost of mapping. Default false.
+    #[serde(default)]
+    pub remap_all: bool,
 }
 
 fn default_alpha() -> f64 {
