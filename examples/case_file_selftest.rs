@@ -124,6 +124,7 @@ fn test_header(scene_toml: &str) -> CaseHeader {
         next_gid: 5000,
         ranks: 0,
         tracked_gids: vec![1007, 1000 + 7 * 56, u64::MAX],
+        rank_counts: Vec::new(),
     }
 }
 

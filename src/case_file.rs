@@ -31,7 +31,9 @@ mod datasets;
 #[path = "case_file/error.rs"]
 mod error;
 #[path = "case_file/ffi.rs"]
-mod ffi;
+pub(crate) mod ffi;
+#[path = "case_file/gauss.rs"]
+mod gauss;
 #[path = "case_file/header.rs"]
 mod header;
 #[path = "case_file/particles.rs"]
@@ -49,6 +51,7 @@ use mpi::traits::*;
 
 pub use collective::block_range;
 pub use error::{CaseError, CaseErrorKind};
+pub use gauss::{GaussRecords, GAUSS_LEN};
 pub use particles::{ParticleSet, STATE_LEN};
 
 use crate::scene::{generate_particles, lattice, Scene};
@@ -80,6 +83,9 @@ pub struct CaseHeader {
     pub ranks: u32,
     /// Global id of the particle tracked by each `[[point_load]]`, in scene order.
     pub tracked_gids: Vec<u64>,
+    /// Particles written by each rank, in rank order ([`write_case`] records them). A reader
+    /// with the same rank count takes the same blocks, so a restart keeps the partition.
+    pub rank_counts: Vec<u64>,
 }
 
 /// A new case at step 0: the scene's particle lattice and, for each point load, the particle
@@ -102,6 +108,7 @@ pub fn new_case(scene: &Scene, source: &str) -> (CaseHeader, ParticleSet) {
         next_gid: particles.len() as u64,
         ranks: 1,
         tracked_gids,
+        rank_counts: Vec::new(),
     };
     (header, particles)
 }
@@ -151,7 +158,11 @@ fn tmp_path(path: &Path) -> PathBuf {
     PathBuf::from(name)
 }
 
-fn mpio_file(comm: &SimpleCommunicator, path: &Path, create: bool) -> hdf5::Result<File> {
+pub(crate) fn mpio_file(
+    comm: &SimpleCommunicator,
+    path: &Path,
+    create: bool,
+) -> hdf5::Result<File> {
     let mut builder = File::with_options();
     builder.with_fapl(|p| p.mpio(comm.as_raw(), None));
     if create {
@@ -195,6 +206,7 @@ fn read_column<T: H5Type>(
     ffi::read_collective(ds, &selected, out)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn write_contents(
     file: &File,
     header: &CaseHeader,
@@ -202,8 +214,11 @@ fn write_contents(
     local: &ParticleSet,
     rows: Range<usize>,
     n: usize,
+    gauss: &GaussRecords,
+    gauss_rows: (Range<usize>, usize),
 ) -> hdf5::Result<()> {
     header::write_header(file, header, ranks)?;
+    gauss::write(file, gauss, gauss_rows.0, gauss_rows.1)?;
     let group = file.create_group(datasets::GROUP)?;
     let [gid, position, displacement, h, state, flags] = datasets::columns();
     write_column(&group, &gid, n, rows.clone(), &local.gid)?;
@@ -236,6 +251,18 @@ pub fn write_case(
     header: &CaseHeader,
     local: &ParticleSet,
 ) -> Result<(), CaseError> {
+    write_checkpoint(comm, path, header, local, &GaussRecords::default())
+}
+
+/// Collective. [`write_case`] plus the Gauss states of this rank's owned triangles (group
+/// `/gauss`), so a restart continues exactly where the run stopped.
+pub fn write_checkpoint(
+    comm: &SimpleCommunicator,
+    path: &Path,
+    header: &CaseHeader,
+    local: &ParticleSet,
+    gauss: &GaussRecords,
+) -> Result<(), CaseError> {
     let checked = local
         .check_lengths()
         .map_err(|m| CaseError::new(path, CaseErrorKind::InvalidInput, m));
@@ -252,6 +279,25 @@ pub fn write_case(
     comm.all_reduce_into(&count, &mut total, mpi::collective::SystemOperation::sum());
     let start = (inclusive - count) as usize;
     let rows = start..start + local.len();
+    let mut counts = vec![0u64; comm.size() as usize];
+    comm.all_gather_into(&count, &mut counts[..]);
+    let mut header = header.clone();
+    header.rank_counts = counts;
+    let gcount = gauss.len() as u64;
+    let mut ginclusive = 0u64;
+    comm.scan_into(
+        &gcount,
+        &mut ginclusive,
+        mpi::collective::SystemOperation::sum(),
+    );
+    let mut gtotal = 0u64;
+    comm.all_reduce_into(
+        &gcount,
+        &mut gtotal,
+        mpi::collective::SystemOperation::sum(),
+    );
+    let gstart = (ginclusive - gcount) as usize;
+    let gauss_rows = (gstart..gstart + gauss.len(), gtotal as usize);
 
     let tmp = tmp_path(path);
     let created = mpio_file(comm, &tmp, true).map_err(|e| {
@@ -263,7 +309,16 @@ pub fn write_case(
     });
     let file = agree(comm, path, created)?;
     let ranks = comm.size() as u32;
-    let written = write_contents(&file, header, ranks, local, rows, total as usize);
+    let written = write_contents(
+        &file,
+        &header,
+        ranks,
+        local,
+        rows,
+        total as usize,
+        gauss,
+        gauss_rows,
+    );
     let closed = file.close();
     let outcome = written.and(closed).map_err(|e| {
         CaseError::new(
@@ -301,7 +356,8 @@ fn read_contents(
 ) -> Result<(CaseHeader, ParticleSet), CaseError> {
     let header = agree(comm, path, header::read_header(file, path))?;
     let (ds, n) = agree(comm, path, datasets::open_all(file, path))?;
-    let block = block_range(n, comm.size() as u64, comm.rank() as u64);
+    let block = same_blocks(&header, n, comm)
+        .unwrap_or_else(|| block_range(n, comm.size() as u64, comm.rank() as u64));
     let rows = block.start as usize..block.end as usize;
     let count = rows.len();
     let mut p = ParticleSet {
@@ -345,6 +401,33 @@ fn read_contents(
     });
     agree(comm, path, read)?;
     Ok((header, p))
+}
+
+/// The block this rank wrote, when the file was written by as many ranks as read it.
+fn same_blocks(header: &CaseHeader, n: u64, comm: &SimpleCommunicator) -> Option<Range<u64>> {
+    let counts = &header.rank_counts;
+    if counts.len() != comm.size() as usize || counts.iter().sum::<u64>() != n {
+        return None;
+    }
+    let r = comm.rank() as usize;
+    let start: u64 = counts[..r].iter().sum();
+    Some(start..start + counts[r])
+}
+
+/// Collective. [`read_case`] plus a block of the stored Gauss states (empty for a new case).
+pub fn read_checkpoint(
+    comm: &SimpleCommunicator,
+    path: &Path,
+) -> Result<(CaseHeader, ParticleSet, GaussRecords), CaseError> {
+    let (header, particles) = read_case(comm, path)?;
+    let opened = mpio_file(comm, path, false).map_err(|e| open_error(path, e));
+    let file = agree(comm, path, opened)?;
+    let records = gauss::read(comm, &file, path);
+    let closed = file
+        .close()
+        .map_err(|e| CaseError::new(path, CaseErrorKind::Io, format!("cannot close: {e}")));
+    let records = agree(comm, path, records.and_then(|g| closed.map(|_| g)))?;
+    Ok((header, particles, records))
 }
 
 /// Collective. Reads the header on every rank and a contiguous block of the particles on each

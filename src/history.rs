@@ -95,7 +95,8 @@ impl HistoryFile {
     pub fn append(&mut self, step: u64, values: &[f64]) -> Result<(), String> {
         let mut line = step.to_string();
         for v in values {
-            line.push_str(&format!(",{v:.10e}"));
+            // Shortest representation that reads back to the same f64: runs compare bit for bit.
+            line.push_str(&format!(",{v:e}"));
         }
         writeln!(self.file, "{line}").map_err(|e| format!("{}: {e}", self.path.display()))
     }

@@ -25,6 +25,18 @@ impl TriStates {
         TriStates { keys, states }
     }
 
+    /// From unordered (key, states) pairs; a key given twice keeps its first states.
+    pub fn from_pairs(mut pairs: Vec<([u64; 3], [GaussState; 3])>) -> TriStates {
+        pairs.sort_by_key(|p| p.0);
+        pairs.dedup_by_key(|p| p.0);
+        let (keys, states) = pairs.into_iter().unzip();
+        TriStates { keys, states }
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = (&[u64; 3], &[GaussState; 3])> {
+        self.keys.iter().zip(&self.states)
+    }
+
     pub fn get(&self, key: &[u64; 3]) -> Option<&[GaussState; 3]> {
         self.keys.binary_search(key).ok().map(|i| &self.states[i])
     }

@@ -30,4 +30,4 @@ pub use error::PartitionError;
 pub use halo::Halo;
 pub use metis_part::{imbalance, partition_graph};
 pub use migrate::{block_range, migrate, try_migrate, Items};
-pub use reduce::{allgather_u64, fetch_pairs, max_f64, sum_f64};
+pub use reduce::{allgather_u64, fetch_pairs, locate, max_f64, sum_f64};

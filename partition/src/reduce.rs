@@ -99,3 +99,47 @@ pub fn fetch_pairs(
         None => Ok(out),
     }
 }
+
+/// Collective. The owner rank of each of `queries` (global ids), given every rank's owned ids:
+/// a directory spread over the ranks by `id % size` answers. Unknown ids get -1.
+pub fn locate(comm: &Comm, owned: &[u64], queries: &[u64]) -> Vec<i32> {
+    let size = comm_size(comm);
+    let me = comm.rank() as u64;
+    let mut register: Vec<Vec<u64>> = vec![Vec::new(); size];
+    for &g in owned {
+        register[(g % size as u64) as usize].extend_from_slice(&[g, me]);
+    }
+    let registered = alltoallv(comm, &register);
+    let directory: std::collections::HashMap<u64, u64> = registered
+        .iter()
+        .flat_map(|r| r.chunks_exact(2).map(|c| (c[0], c[1])))
+        .collect();
+    let mut ask: Vec<Vec<u64>> = vec![Vec::new(); size];
+    for &q in queries {
+        ask[(q % size as u64) as usize].push(q);
+    }
+    let asked = alltoallv(comm, &ask);
+    let replies: Vec<Vec<u64>> = asked
+        .iter()
+        .map(|qs| {
+            qs.iter()
+                .map(|q| directory.get(q).copied().unwrap_or(u64::MAX))
+                .collect()
+        })
+        .collect();
+    let answers = alltoallv(comm, &replies);
+    let mut next = vec![0usize; size];
+    queries
+        .iter()
+        .map(|&q| {
+            let d = (q % size as u64) as usize;
+            let a = answers[d][next[d]];
+            next[d] += 1;
+            if a == u64::MAX {
+                -1
+            } else {
+                a as i32
+            }
+        })
+        .collect()
+}

@@ -39,7 +39,11 @@ pub fn write_header(file: &File, h: &CaseHeader, ranks: u32) -> hdf5::Result<()>
     file.new_attr::<u64>()
         .shape(h.tracked_gids.len())
         .create("tracked_gids")?
-        .write_raw(&h.tracked_gids)
+        .write_raw(&h.tracked_gids)?;
+    file.new_attr::<u64>()
+        .shape(h.rank_counts.len())
+        .create("rank_counts")?
+        .write_raw(&h.rank_counts)
 }
 
 struct Reader<'a> {
@@ -174,5 +178,15 @@ pub fn read_header(file: &File, path: &Path) -> Result<CaseHeader, CaseError> {
         next_gid: r.scalar("next_gid")?,
         ranks: r.scalar("ranks")?,
         tracked_gids: r.u64_array("tracked_gids")?,
+        rank_counts: if file
+            .attr_names()
+            .unwrap_or_default()
+            .iter()
+            .any(|n| n == "rank_counts")
+        {
+            r.u64_array("rank_counts")?
+        } else {
+            Vec::new()
+        },
     })
 }

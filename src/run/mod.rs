@@ -2,6 +2,8 @@
 
 mod progress;
 mod refinement;
+mod restart;
+mod signals;
 mod simulation;
 
 pub use simulation::{Simulation, StepReport};
@@ -19,14 +21,14 @@ pub struct RunOptions {
     pub until_step: Option<u64>,
 }
 
-/// Collective. Runs the case to its last step (or `until_step`).
+/// Collective. Runs the case to its last step (or `until_step`, or the step during which SIGTERM
+/// or SIGUSR1 arrived), ending with a checkpoint.
 pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), String> {
+    let stop = signals::StopRequest::install()?;
     let mut sim = Simulation::load(world, &opts.case)?;
     let mut out = simulation::Output::open(world, &sim, &opts.out_dir)?;
     let mut progress = Progress::new(world, sim.total_steps());
-    let last = opts
-        .until_step
-        .map_or(sim.total_steps(), |k| k.min(sim.total_steps()));
+    let mut last = opts.until_step.unwrap_or(u64::MAX).min(sim.total_steps());
     while sim.step() < last {
         let mut t = PhaseTimer::default();
         let mesh = t.time("remesh", || sim.remesh(world))?;
@@ -34,6 +36,9 @@ pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), String>
         let solved = t.time("solve", || sim.solve(world, petsc, &mesh, &states))?;
         let report = t.time("update", || sim.update(world, &mesh, solved))?;
         t.time("output", || out.record(world, &sim))?;
+        if stop.requested(world) {
+            last = sim.step();
+        }
         t.time("checkpoint", || out.checkpoint_if_due(world, &sim, last))?;
         t.time("balance", || sim.rebalance_if_needed(world))?;
         progress.step(&sim, &report, &t);

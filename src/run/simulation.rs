@@ -1,6 +1,6 @@
 //! The state of a running analysis on one rank and one function per phase of the method.
 
-use crate::case_file::{read_case, write_case, CaseHeader, ParticleSet};
+use crate::case_file::{read_checkpoint, CaseHeader};
 use crate::history::{self, HistoryFile, Measures};
 use crate::mapping::{map_states, recover_at_particles, TriStates};
 use crate::material::GaussState;
@@ -51,7 +51,8 @@ fn err<E: std::fmt::Display>(e: E) -> String {
 impl Simulation {
     /// Collective. Reads a case or checkpoint on any rank count and partitions it with METIS.
     pub fn load(world: &Comm, path: &Path) -> Result<Simulation, String> {
-        let (header, set) = read_case(world, path).map_err(err)?;
+        let (header, set, gauss) = read_checkpoint(world, path).map_err(err)?;
+        let same_partition = header.step > 0 && header.rank_counts.len() == world.size() as usize;
         let scene = Scene::from_toml(&header.scene_toml, &path.display().to_string(), &[])
             .map_err(|e| e.to_string())?;
         let model = Model::new(&scene).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -77,9 +78,10 @@ impl Simulation {
             ghosts: Ghosts::default(),
             tri_states: TriStates::default(),
         };
-        if world.size() > 1 {
+        if world.size() > 1 && !same_partition {
             sim.repartition(world)?;
         }
+        sim.restore_gauss(world, gauss);
         Ok(sim)
     }
 
@@ -331,23 +333,6 @@ impl Simulation {
             Particles::from_records(gid, &rec, fl.into_iter().map(|f| f as u32).collect());
         self.tri_states = TriStates::default();
         Ok(())
-    }
-
-    /// Collective. Writes this state as a case file that any rank count can continue from.
-    pub fn write_checkpoint(&self, world: &Comm, path: &Path) -> Result<(), String> {
-        let p = &self.particles;
-        let set = ParticleSet {
-            gid: p.gid.clone(),
-            position: p.position.clone(),
-            displacement: p.displacement.clone(),
-            h: p.h.clone(),
-            state: p.state.clone(),
-            flags: p.flags.iter().map(|f| f & !flag::TRACKED).collect(),
-        };
-        let mut header = self.header.clone();
-        header.ranks = world.size() as u32;
-        header.code_version = env!("CARGO_PKG_VERSION").to_string();
-        write_case(world, path, &header, &set).map_err(err)
     }
 }
 

@@ -1,0 +1,79 @@
+//! Checkpoints that restart exactly: the particles (in the writer's rank blocks, so the same rank
+//! count keeps its partition) and the Gauss states of the last mesh, routed on restart to every
+//! rank whose owned particles touch the triangle.
+
+use super::Simulation;
+use crate::case_file::{write_checkpoint, GaussRecords, ParticleSet, GAUSS_LEN};
+use crate::mapping::TriStates;
+use crate::material::GaussState;
+use crate::particles::flag;
+use mpi::traits::Communicator;
+use pfem_partition::{alltoallv, locate, Comm};
+
+const K: usize = GaussState::LEN;
+
+impl Simulation {
+    /// Collective. Writes this state as a case file that any rank count can continue from.
+    pub fn write_checkpoint(&self, world: &Comm, path: &std::path::Path) -> Result<(), String> {
+        let p = &self.particles;
+        let set = ParticleSet {
+            gid: p.gid.clone(),
+            position: p.position.clone(),
+            displacement: p.displacement.clone(),
+            h: p.h.clone(),
+            state: p.state.clone(),
+            flags: p.flags.iter().map(|f| f & !flag::TRACKED).collect(),
+        };
+        let mut records = GaussRecords::default();
+        for (key, states) in self.tri_states.iter() {
+            // Each triangle once: by the owner of its smallest-gid vertex.
+            if p.gid.binary_search(&key[0]).is_ok() {
+                records.key.push(*key);
+                let mut flat = [0.0; GAUSS_LEN];
+                for (q, s) in states.iter().enumerate() {
+                    flat[q * K..(q + 1) * K].copy_from_slice(&s.to_array());
+                }
+                records.state.push(flat);
+            }
+        }
+        let mut header = self.header.clone();
+        header.code_version = env!("CARGO_PKG_VERSION").to_string();
+        write_checkpoint(world, path, &header, &set, &records).map_err(|e| e.to_string())
+    }
+
+    /// Collective. Sends each stored triangle to the owners of its vertices.
+    pub(super) fn restore_gauss(&mut self, world: &Comm, records: GaussRecords) {
+        let queries: Vec<u64> = records.key.iter().flatten().copied().collect();
+        let owners = locate(world, &self.particles.gid, &queries);
+        let mut send: Vec<Vec<u64>> = vec![Vec::new(); world.size() as usize];
+        for (t, key) in records.key.iter().enumerate() {
+            let mut dest: Vec<i32> = owners[3 * t..3 * t + 3]
+                .iter()
+                .copied()
+                .filter(|&r| r >= 0)
+                .collect();
+            dest.sort_unstable();
+            dest.dedup();
+            for r in dest {
+                send[r as usize].extend_from_slice(key);
+                send[r as usize].extend(records.state[t].iter().map(|x| x.to_bits()));
+            }
+        }
+        let received = alltoallv(world, &send);
+        let pairs = received
+            .iter()
+            .flat_map(|r| r.chunks_exact(3 + GAUSS_LEN))
+            .map(|c| {
+                let states = std::array::from_fn(|q| {
+                    let mut a = [0.0; K];
+                    for (k, x) in a.iter_mut().enumerate() {
+                        *x = f64::from_bits(c[3 + q * K + k]);
+                    }
+                    GaussState::from_array(&a)
+                });
+                ([c[0], c[1], c[2]], states)
+            })
+            .collect();
+        self.tri_states = TriStates::from_pairs(pairs);
+    }
+}
