@@ -13,6 +13,7 @@ pub mod mapping;
 pub mod material;
 pub mod mesh;
 pub mod model;
+pub mod output;
 pub mod particles;
 pub mod petsc;
 pub mod run;

@@ -4,4 +4,5 @@
 pub mod element;
 pub mod p2;
 pub mod quadrature;
+pub mod mixed;
 pub mod recovery;

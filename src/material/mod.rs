@@ -14,6 +14,7 @@
 //! gradient, so that is the element's job, not the material's.
 
 pub mod elastic;
+pub mod tresca;
 
 use std::fmt;
 
@@ -126,6 +127,27 @@ pub trait Material: Send + Sync + fmt::Debug {
     /// from the same `state_n`.
     fn update(&self, state_n: &GaussState, e: &[f64; 4])
         -> Result<MaterialResponse, MaterialError>;
+
+    /// Computes the response to the *logarithmic* strain of the step with the step's rotation
+    /// removed, for elements that do the rotation themselves ([`crate::fem::mixed`]).
+    ///
+    /// With the polar decomposition F = R U of the step deformation gradient, `eps` is
+    /// ε = ln U = ½ ln(FᵀF) (Voigt, engineering shear, `eps[2] = 0`), expressed in the
+    /// start-of-step frame. The returned `s` is then the end-of-step Cauchy stress *before* the
+    /// rotation R is applied (σ_{n+1} = R s Rᵀ), and `d = ds/dε`. Elements that supply their own
+    /// pressure field use only the deviatoric parts of `s` and `d`.
+    ///
+    /// The default forwards to [`Material::update`]: the models in this module are of the form
+    /// σ_n + ΔS(strain) with ΔS a small-strain law, which is exactly a rate-form (hypoelastic /
+    /// plastic) law when it is fed a rotation-free strain measure. A model whose `update` is not of
+    /// that form (e.g. a hyperelastic law in C) must override this.
+    fn update_log_strain(
+        &self,
+        state_n: &GaussState,
+        eps: &[f64; 4],
+    ) -> Result<MaterialResponse, MaterialError> {
+        self.update(state_n, eps)
+    }
 
     /// Short identifier used in logs and input files.
     fn name(&self) -> &'static str;

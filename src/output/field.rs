@@ -180,10 +180,7 @@ mod tests {
         let v = Field::Vector("u", vec![[1.0, 2.0], [3.0, 4.0]]);
         assert_eq!(&*v.stored(), &[1.0, 2.0, 0.0, 3.0, 4.0, 0.0]);
         let t = Field::Tensor("s", vec![[1.0, 2.0, 3.0, 4.0]]);
-        assert_eq!(
-            &*t.stored(),
-            &[1.0, 4.0, 0.0, 4.0, 2.0, 0.0, 0.0, 0.0, 3.0]
-        );
+        assert_eq!(&*t.stored(), &[1.0, 4.0, 0.0, 4.0, 2.0, 0.0, 0.0, 0.0, 3.0]);
         let s = [5.0, 6.0];
         assert_eq!(&*Field::ScalarRef("p", &s).stored(), &s);
         assert_eq!(t.kind().components(), 9);
@@ -191,12 +188,18 @@ mod tests {
 
     #[test]
     fn bad_names_and_lengths_are_rejected() {
-        let ok = [Field::Scalar("p", vec![0.0]), Field::Vector("u-1", vec![[0.0; 2]])];
+        let ok = [
+            Field::Scalar("p", vec![0.0]),
+            Field::Vector("u-1", vec![[0.0; 2]]),
+        ];
         assert!(check_fields(&ok, 1).is_ok());
         let e = check_fields(&ok, 2).unwrap_err();
         assert!(e.contains("\"p\" has 1 values for 2"), "{e}");
         for bad in ["", "a/b", "a:b", "a b", "é"] {
-            assert!(check_fields(&[Field::Scalar(bad, vec![])], 0).is_err(), "{bad}");
+            assert!(
+                check_fields(&[Field::Scalar(bad, vec![])], 0).is_err(),
+                "{bad}"
+            );
         }
         assert!(check_fields(&[Field::Scalar("gid", vec![])], 0).is_err());
         let twice = [Field::Scalar("p", vec![]), Field::ScalarRef("p", &[])];
@@ -210,6 +213,9 @@ mod tests {
         let c = [Field::Scalar("q", vec![]).desc()];
         assert_ne!(signature(&a), signature(&b));
         assert_ne!(signature(&a), signature(&c));
-        assert_eq!(signature(&a), signature(&[Field::ScalarRef("p", &[]).desc()]));
+        assert_eq!(
+            signature(&a),
+            signature(&[Field::ScalarRef("p", &[]).desc()])
+        );
     }
 }

@@ -85,10 +85,11 @@ pub(crate) fn frame_entry(f: &FrameInfo<'_>) -> FrameEntry {
     x.push_str("        <Geometry GeometryType=\"XY\">\n");
     data_item(&mut x, &format!("{n} 2"), "Float", &file, "geometry");
     x.push_str("        </Geometry>\n");
-    attribute(&mut x, GID, Kind::Scalar, n, "Int", &file);
     for d in f.fields {
         attribute(&mut x, d.name, d.kind, n, "Float", &file);
     }
+    // Last, so that readers make the caller's first scalar field, not the ids, the active one.
+    attribute(&mut x, GID, Kind::Scalar, n, "Int", &file);
     x.push_str("      ");
     x.push_str(GRID_CLOSE);
     FrameEntry {
@@ -131,9 +132,12 @@ pub(crate) fn parse_series(text: &str) -> Result<Vec<FrameEntry>, String> {
             .chars()
             .take_while(char::is_ascii_digit)
             .collect();
-        let step: u64 = digits
-            .parse()
-            .map_err(|_| format!("frame without a step number at byte {}", text.len() - block.len()))?;
+        let step: u64 = digits.parse().map_err(|_| {
+            format!(
+                "frame without a step number at byte {}",
+                text.len() - block.len()
+            )
+        })?;
         if xml[1..].contains("<Grid") {
             return Err(format!("frame of step {step} is not a single uniform grid"));
         }
@@ -184,7 +188,10 @@ mod tests {
     fn frame_describes_every_dataset() {
         let e = entry(12, 0.25);
         let x = &e.xml;
-        assert!(x.starts_with("<Grid Name=\"step_000012\" GridType=\"Uniform\">"), "{x}");
+        assert!(
+            x.starts_with("<Grid Name=\"step_000012\" GridType=\"Uniform\">"),
+            "{x}"
+        );
         assert!(x.ends_with("</Grid>"));
         assert!(x.contains("<Time Value=\"0.25\"/>"));
         assert!(x.contains("NumberOfElements=\"8\""));

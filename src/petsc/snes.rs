@@ -47,9 +47,12 @@ struct Ctx<'a> {
 const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
 
 impl Snes {
-    /// Collective. Newton with line search; direct MUMPS LU by default (robust for the indefinite
-    /// and badly conditioned systems of nearly incompressible soil), every choice overridable by
-    /// PETSc options on the command line.
+    /// Collective. Newton with full steps and a direct LU solve by MUMPS by default: robust for the
+    /// indefinite saddle points of nearly incompressible soil and fast on 1-3 ranks, where
+    /// SuperLU_dist stalled on 3 oversubscribed ranks. MUMPS on several ranks sums contribution
+    /// blocks in message-arrival order, so two identical multi-rank runs agree to round-off, not
+    /// bit for bit; `-pc_factor_mat_solver_type superlu_dist` is bitwise reproducible on 2 ranks.
+    /// Every choice is overridable by PETSc options on the command line.
     pub fn new(comm: &SimpleCommunicator, rtol: f64, max_it: usize) -> Result<Snes, PetscError> {
         let mut raw: ffi::SNES = std::ptr::null_mut();
         // SAFETY: fresh handle; KSP/PC are borrowed from the SNES and not destroyed by us.
@@ -68,9 +71,9 @@ impl Snes {
             check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
             let lu = cstring("lu")?;
             check(ffi::PCSetType(pc, lu.as_ptr()), "PCSetType")?;
-            let mumps = cstring("mumps")?;
+            let direct = cstring("mumps")?;
             check(
-                ffi::PCFactorSetMatSolverType(pc, mumps.as_ptr()),
+                ffi::PCFactorSetMatSolverType(pc, direct.as_ptr()),
                 "PCFactorSetMatSolverType",
             )?;
             // Full Newton steps: the large-rotation residual grows on the first iterate of a load
