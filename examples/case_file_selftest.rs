@@ -61,6 +61,7 @@ fn global_particles(n: usize) -> ParticleSet {
         p.gid.push(1000 + 7 * i);
         p.position.push([value(10 * i), value(10 * i + 1)]);
         p.displacement.push([value(10 * i + 2), value(10 * i + 3)]);
+        p.increment.push([value(10 * i + 8), value(10 * i + 9)]);
         p.h.push(value(10 * i + 4));
         p.state
             .push(std::array::from_fn(|k| value(10 * i + 5 + 1000 * k as u64)));
@@ -79,6 +80,7 @@ fn same_bits(a: &ParticleSet, b: &ParticleSet) -> bool {
     a.gid == b.gid
         && bits2(&a.position) == bits2(&b.position)
         && bits2(&a.displacement) == bits2(&b.displacement)
+        && bits2(&a.increment) == bits2(&b.increment)
         && a.h
             .iter()
             .map(|x| x.to_bits())

@@ -19,7 +19,8 @@
 //!
 //! Datasets in group `/particles`, n = global particle count, one row per particle:
 //! `gid` (u64, n), `position` (f64, n x 2, current), `displacement` (f64, n x 2, total since the
-//! start), `h` (f64, n), `state` (f64, n x 9), `flags` (u32, n).
+//! start), `h` (f64, n), `state` (f64, n x 9), `flags` (u32, n), `increment` (f64, n x 2, the
+//! last step's displacement increment).
 //!
 //! The file is written collectively by all ranks (each writes its own rows, placed by rank
 //! order) and can be read back by any number of ranks, each getting a contiguous block.
@@ -220,8 +221,15 @@ fn write_contents(
     header::write_header(file, header, ranks)?;
     gauss::write(file, gauss, gauss_rows.0, gauss_rows.1)?;
     let group = file.create_group(datasets::GROUP)?;
-    let [gid, position, displacement, h, state, flags] = datasets::columns();
+    let [gid, position, displacement, h, state, flags, increment] = datasets::columns();
     write_column(&group, &gid, n, rows.clone(), &local.gid)?;
+    write_column(
+        &group,
+        &increment,
+        n,
+        rows.clone(),
+        local.increment.as_flattened(),
+    )?;
     write_column(
         &group,
         &position,
@@ -364,12 +372,19 @@ fn read_contents(
         gid: vec![0; count],
         position: vec![[0.0; 2]; count],
         displacement: vec![[0.0; 2]; count],
+        increment: vec![[0.0; 2]; count],
         h: vec![0.0; count],
         state: vec![[0.0; STATE_LEN]; count],
         flags: vec![0; count],
     };
-    let [gid, position, displacement, h, state, flags] = datasets::columns();
+    let [gid, position, displacement, h, state, flags, increment] = datasets::columns();
     let read = (|| {
+        read_column(
+            &ds[6],
+            increment.width,
+            rows.clone(),
+            p.increment.as_flattened_mut(),
+        )?;
         read_column(&ds[0], gid.width, rows.clone(), &mut p.gid)?;
         read_column(
             &ds[1],

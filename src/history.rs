@@ -20,6 +20,12 @@ pub struct Measures {
     pub load_factor: f64,
     /// Total displacement of the first tracked particle.
     pub tracked_displacement: [f64; 2],
+    /// Force on the particles of the first `[[prescribed]]` entry (footing, top platen).
+    pub reaction: [f64; 2],
+    /// Area of the body (m² per metre).
+    pub area: f64,
+    /// Current horizontal extent of the particles of the first `[[prescribed]]` entry.
+    pub driven_width: f64,
 }
 
 /// Normalised values of a row (after `step`).
@@ -44,10 +50,36 @@ pub fn row(scene: &Scene, m: &Measures) -> Result<Vec<f64>, String> {
                 -m.tracked_displacement[1] / l,
             ])
         }
-        other => Err(format!(
-            "history.kind = \"{}\" is not available in this build yet",
-            other.as_str()
-        )),
+        HistoryKind::Footing => {
+            // Half model: the footing runs from the symmetry plane (the body's left side) to the
+            // prescribed region's right end, and q = F / B on the full footing = F_half / (B/2).
+            let p = scene
+                .prescribed
+                .first()
+                .ok_or("history.kind = \"footing\" needs a [[prescribed]]")?;
+            let [[x0, _], [x1, _]] = scene.bounding_box();
+            let half = p.region.interval(crate::scene::Axis::X).1.min(x1) - x0;
+            let b = 2.0 * half;
+            let z = -m.load_factor * p.total[1];
+            Ok(vec![z / b, -m.reaction[1] / half / scene.material.cu])
+        }
+        HistoryKind::Block => {
+            let [[_, y0], [_, y1]] = scene.bounding_box();
+            let h0 = y1 - y0;
+            let closing: f64 = scene.prescribed.iter().map(|p| p.total[1].abs()).sum();
+            let area0: f64 = scene
+                .body
+                .rectangles
+                .iter()
+                .map(|r| r.size[0] * r.size[1])
+                .sum();
+            let stress = -m.reaction[1] / m.driven_width;
+            Ok(vec![
+                m.load_factor * closing / h0,
+                stress / scene.material.cu,
+                m.area / area0,
+            ])
+        }
     }
 }
 

@@ -17,6 +17,8 @@ pub struct Particles {
     /// Total displacement since the start of the analysis; position − displacement is the
     /// reference position that boundary selectors look at.
     pub displacement: Vec<[f64; 2]>,
+    /// Displacement increment of the last step: the next step's Newton predictor.
+    pub increment: Vec<[f64; 2]>,
     /// Target spacing.
     pub h: Vec<f64>,
     /// State carried by the particle (Gauss state recovered at the particle).
@@ -31,12 +33,13 @@ pub struct Ghosts {
     pub owner: Vec<i32>,
     pub position: Vec<[f64; 2]>,
     pub displacement: Vec<[f64; 2]>,
+    pub increment: Vec<[f64; 2]>,
     pub h: Vec<f64>,
     pub state: Vec<[f64; GaussState::LEN]>,
 }
 
-/// f64 record per particle in a halo exchange: position, displacement, h, state.
-pub const RECORD: usize = 5 + GaussState::LEN;
+/// f64 record per particle in a halo exchange: position, displacement, increment, h, state.
+pub const RECORD: usize = 7 + GaussState::LEN;
 
 impl Particles {
     pub fn len(&self) -> usize {
@@ -61,6 +64,7 @@ impl Particles {
         self.gid = order.iter().map(|&i| self.gid[i]).collect();
         self.position = order.iter().map(|&i| self.position[i]).collect();
         self.displacement = order.iter().map(|&i| self.displacement[i]).collect();
+        self.increment = order.iter().map(|&i| self.increment[i]).collect();
         self.h = order.iter().map(|&i| self.h[i]).collect();
         self.state = order.iter().map(|&i| self.state[i]).collect();
         self.flags = order.iter().map(|&i| self.flags[i]).collect();
@@ -72,6 +76,7 @@ impl Particles {
         for i in 0..self.len() {
             out.extend_from_slice(&self.position[i]);
             out.extend_from_slice(&self.displacement[i]);
+            out.extend_from_slice(&self.increment[i]);
             out.push(self.h[i]);
             out.extend_from_slice(&self.state[i]);
         }
@@ -88,9 +93,10 @@ impl Particles {
         for r in rec.chunks_exact(RECORD) {
             p.position.push([r[0], r[1]]);
             p.displacement.push([r[2], r[3]]);
-            p.h.push(r[4]);
+            p.increment.push([r[4], r[5]]);
+            p.h.push(r[6]);
             let mut s = [0.0; GaussState::LEN];
-            s.copy_from_slice(&r[5..RECORD]);
+            s.copy_from_slice(&r[7..RECORD]);
             p.state.push(s);
         }
         p
@@ -108,9 +114,10 @@ impl Particles {
         for r in rec.chunks_exact(RECORD) {
             g.position.push([r[0], r[1]]);
             g.displacement.push([r[2], r[3]]);
-            g.h.push(r[4]);
+            g.increment.push([r[4], r[5]]);
+            g.h.push(r[6]);
             let mut s = [0.0; GaussState::LEN];
-            s.copy_from_slice(&r[5..RECORD]);
+            s.copy_from_slice(&r[7..RECORD]);
             g.state.push(s);
         }
         Ok((halo, g))

@@ -19,7 +19,7 @@ pub struct Column {
 }
 
 /// The particle datasets, in the order they are written and checked.
-pub fn columns() -> [Column; 6] {
+pub fn columns() -> [Column; 7] {
     let col = |name, width, dtype| Column { name, width, dtype };
     [
         col("gid", 0, u64::type_descriptor()),
@@ -28,6 +28,7 @@ pub fn columns() -> [Column; 6] {
         col("h", 0, f64::type_descriptor()),
         col("state", STATE_LEN, f64::type_descriptor()),
         col("flags", 0, u32::type_descriptor()),
+        col("increment", 2, f64::type_descriptor()),
     ]
 }
 

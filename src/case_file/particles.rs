@@ -12,6 +12,8 @@ pub struct ParticleSet {
     pub position: Vec<[f64; 2]>,
     /// Total displacement since the start of the analysis (m).
     pub displacement: Vec<[f64; 2]>,
+    /// Displacement increment of the last step (m): the next step's Newton predictor.
+    pub increment: Vec<[f64; 2]>,
     /// Local particle spacing (m).
     pub h: Vec<f64>,
     /// Per-particle material state (stresses, plastic variables), meaning set by the material.
@@ -26,6 +28,7 @@ impl ParticleSet {
             gid: Vec::with_capacity(n),
             position: Vec::with_capacity(n),
             displacement: Vec::with_capacity(n),
+            increment: Vec::with_capacity(n),
             h: Vec::with_capacity(n),
             state: Vec::with_capacity(n),
             flags: Vec::with_capacity(n),
@@ -45,6 +48,7 @@ impl ParticleSet {
         self.gid.push(gid);
         self.position.push(position);
         self.displacement.push([0.0; 2]);
+        self.increment.push([0.0; 2]);
         self.h.push(h);
         self.state.push([0.0; STATE_LEN]);
         self.flags.push(0);
@@ -56,6 +60,7 @@ impl ParticleSet {
             gid: self.gid[range.clone()].to_vec(),
             position: self.position[range.clone()].to_vec(),
             displacement: self.displacement[range.clone()].to_vec(),
+            increment: self.increment[range.clone()].to_vec(),
             h: self.h[range.clone()].to_vec(),
             state: self.state[range.clone()].to_vec(),
             flags: self.flags[range].to_vec(),
@@ -67,6 +72,7 @@ impl ParticleSet {
         self.gid.append(&mut other.gid);
         self.position.append(&mut other.position);
         self.displacement.append(&mut other.displacement);
+        self.increment.append(&mut other.increment);
         self.h.append(&mut other.h);
         self.state.append(&mut other.state);
         self.flags.append(&mut other.flags);
@@ -78,6 +84,7 @@ impl ParticleSet {
         let lens = [
             ("position", self.position.len()),
             ("displacement", self.displacement.len()),
+            ("increment", self.increment.len()),
             ("h", self.h.len()),
             ("state", self.state.len()),
             ("flags", self.flags.len()),

@@ -2,7 +2,7 @@
 //! Gauss-point recovery. Pure numerics: no MPI, no PETSc.
 
 pub mod element;
+pub mod mixed;
 pub mod p2;
 pub mod quadrature;
-pub mod mixed;
 pub mod recovery;

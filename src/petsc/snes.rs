@@ -53,7 +53,12 @@ impl Snes {
     /// blocks in message-arrival order, so two identical multi-rank runs agree to round-off, not
     /// bit for bit; `-pc_factor_mat_solver_type superlu_dist` is bitwise reproducible on 2 ranks.
     /// Every choice is overridable by PETSc options on the command line.
-    pub fn new(comm: &SimpleCommunicator, rtol: f64, max_it: usize) -> Result<Snes, PetscError> {
+    pub fn new(
+        comm: &SimpleCommunicator,
+        rtol: f64,
+        max_it: usize,
+        line_search: &str,
+    ) -> Result<Snes, PetscError> {
         let mut raw: ffi::SNES = std::ptr::null_mut();
         // SAFETY: fresh handle; KSP/PC are borrowed from the SNES and not destroyed by us.
         unsafe {
@@ -76,13 +81,14 @@ impl Snes {
                 ffi::PCFactorSetMatSolverType(pc, direct.as_ptr()),
                 "PCFactorSetMatSolverType",
             )?;
-            // Full Newton steps: the large-rotation residual grows on the first iterate of a load
-            // step before Newton's quadratic phase, and a backtracking search then crawls.
+            // The caller's line search: full steps for elastic large rotations (the residual grows
+            // on the first iterate before the quadratic phase, and backtracking would crawl),
+            // backtracking for plastic flow (elastic-plastic switching overshoots).
             let mut ls: ffi::SNESLineSearch = std::ptr::null_mut();
             check(ffi::SNESGetLineSearch(raw, &mut ls), "SNESGetLineSearch")?;
-            let basic = cstring("basic")?;
+            let kind = cstring(line_search)?;
             check(
-                ffi::SNESLineSearchSetType(ls, basic.as_ptr()),
+                ffi::SNESLineSearchSetType(ls, kind.as_ptr()),
                 "SNESLineSearchSetType",
             )?;
             check(ffi::SNESSetFromOptions(raw), "SNESSetFromOptions")?;

@@ -1,10 +1,12 @@
 //! The PFEM step loop (the method's Fig. 1): remesh, map, solve, update, output, checkpoint.
 
+mod output;
 mod progress;
 mod refinement;
 mod restart;
 mod signals;
 mod simulation;
+mod step;
 
 pub use simulation::{Simulation, StepReport};
 
@@ -26,7 +28,7 @@ pub struct RunOptions {
 pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), String> {
     let stop = signals::StopRequest::install()?;
     let mut sim = Simulation::load(world, &opts.case)?;
-    let mut out = simulation::Output::open(world, &sim, &opts.out_dir)?;
+    let mut out = output::Output::open(world, &sim, &opts.out_dir)?;
     let mut progress = Progress::new(world, sim.total_steps());
     let mut last = opts.until_step.unwrap_or(u64::MAX).min(sim.total_steps());
     while sim.step() < last {
@@ -35,10 +37,13 @@ pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), String>
         let states = t.time("map", || sim.map(&mesh));
         let solved = t.time("solve", || sim.solve(world, petsc, &mesh, &states))?;
         let report = t.time("update", || sim.update(world, &mesh, solved))?;
-        t.time("output", || out.record(world, &sim))?;
         if stop.requested(world) {
             last = sim.step();
         }
+        t.time("output", || {
+            out.record(world, &sim)
+                .and_then(|_| out.fields_if_due(world, &sim, &mesh, last))
+        })?;
         t.time("checkpoint", || out.checkpoint_if_due(world, &sim, last))?;
         t.time("balance", || sim.rebalance_if_needed(world))?;
         progress.step(&sim, &report, &t);

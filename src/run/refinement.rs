@@ -60,6 +60,13 @@ impl Simulation {
                 self.ghosts.displacement[p - n]
             }
         };
+        let incr = |p: usize| {
+            if p < n {
+                self.particles.increment[p]
+            } else {
+                self.ghosts.increment[p - n]
+            }
+        };
 
         // Smoothed particles take the old field's values at their new place.
         let mut moved = HashSet::new();
@@ -100,6 +107,7 @@ impl Simulation {
                 first_new + rank as u64,
                 mid(mesh.points[a], mesh.points[b]),
                 mid(disp(a), disp(b)),
+                mid(incr(a), incr(b)),
                 0.5 * (mesh.h[a] + mesh.h[b]),
                 state,
             ));
@@ -110,10 +118,11 @@ impl Simulation {
             p.displacement[i] = u;
             p.state[i] = state;
         }
-        for (gid, x, u, h, state) in born {
+        for (gid, x, u, du, h, state) in born {
             p.gid.push(gid);
             p.position.push(x);
             p.displacement.push(u);
+            p.increment.push(du);
             p.h.push(h);
             p.state.push(state);
             p.flags.push(0);
@@ -124,6 +133,7 @@ impl Simulation {
             retain(&mut p.gid, &keep);
             retain(&mut p.position, &keep);
             retain(&mut p.displacement, &keep);
+            retain(&mut p.increment, &keep);
             retain(&mut p.h, &keep);
             retain(&mut p.state, &keep);
             retain(&mut p.flags, &keep);

@@ -20,6 +20,7 @@ impl Simulation {
             gid: p.gid.clone(),
             position: p.position.clone(),
             displacement: p.displacement.clone(),
+            increment: p.increment.clone(),
             h: p.h.clone(),
             state: p.state.clone(),
             flags: p.flags.iter().map(|f| f & !flag::TRACKED).collect(),

@@ -1,19 +1,17 @@
 //! The state of a running analysis on one rank and one function per phase of the method.
 
 use crate::case_file::{read_checkpoint, CaseHeader};
-use crate::history::{self, HistoryFile, Measures};
-use crate::mapping::{map_states, recover_at_particles, TriStates};
+use crate::history::Measures;
+use crate::mapping::{map_states, TriStates};
 use crate::material::GaussState;
 use crate::mesh::local::halo_width;
 use crate::mesh::LocalMesh;
 use crate::model::Model;
 use crate::particles::{flag, Ghosts, Particles};
-use crate::petsc::{Mat, PVec, Petsc, Snes};
 use crate::scene::Scene;
-use crate::solve::{Constraints, DofMap, StepProblem, StepSetup};
 use mpi::traits::Communicator;
 use pfem_partition::{imbalance, max_f64, migrate, partition_graph, sum_f64, Comm};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Repartition when the largest rank holds this much more than the mean.
 const IMBALANCE_LIMIT: f64 = 1.2;
@@ -24,16 +22,10 @@ pub struct Simulation {
     pub(super) particles: Particles,
     pub(super) ghosts: Ghosts,
     pub(super) tri_states: TriStates,
+    /// This rank's share of the last step's footing/platen reaction and body area.
+    pub(super) last_reaction: [f64; 2],
+    pub(super) last_area: f64,
     first_step: u64,
-}
-
-/// The solved step, before particles move.
-pub struct Solved {
-    dofs: DofMap,
-    du: Vec<[f64; 2]>,
-    states: Vec<[GaussState; 3]>,
-    newton_iterations: usize,
-    residual_norm: f64,
 }
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -60,6 +52,7 @@ impl Simulation {
             gid: set.gid,
             position: set.position,
             displacement: set.displacement,
+            increment: set.increment,
             h: set.h,
             state: set.state,
             flags: set.flags,
@@ -77,6 +70,8 @@ impl Simulation {
             particles,
             ghosts: Ghosts::default(),
             tri_states: TriStates::default(),
+            last_reaction: [0.0; 2],
+            last_area: 0.0,
         };
         if world.size() > 1 && !same_partition {
             sim.repartition(world)?;
@@ -172,116 +167,41 @@ impl Simulation {
         }
     }
 
-    /// Collective. One implicit updated-Lagrangian increment by Newton (PETSc SNES).
-    pub fn solve(
-        &self,
-        world: &Comm,
-        petsc: &Petsc,
-        mesh: &LocalMesh,
-        states_n: &[[GaussState; 3]],
-    ) -> Result<Solved, String> {
-        let _ = petsc;
-        let step = self.header.step + 1;
-        let dofs = DofMap::build(world, mesh).map_err(err)?;
-        let constraints = Constraints::build(&dofs, |p| {
-            self.model.step_bc(self.reference_position(mesh, p))
-        });
-        let factor = self.model.load_factor(step);
-        let mut point_loads = Vec::new();
-        for (load, &gid) in self
-            .model
-            .scene
-            .point_load
-            .iter()
-            .zip(&self.header.tracked_gids)
-        {
-            if let Ok(i) = self.particles.gid.binary_search(&gid) {
-                let node = dofs.node_of_point[i];
-                if node != u32::MAX {
-                    point_loads.push((node, [factor * load.force[0], factor * load.force[1]]));
-                }
-            }
-        }
-        let setup = StepSetup {
-            material: self.model.material.as_ref(),
-            states_n,
-            body_force: self.model.body_force,
-            constraints: &constraints,
-            point_loads,
-        };
-        let x = PVec::mpi(world, dofs.n_owned_dofs).map_err(err)?;
-        let (d_nnz, o_nnz) = dofs.preallocation();
-        let jac = Mat::aij(world, dofs.n_owned_dofs, &d_nnz, &o_nnz).map_err(err)?;
-        let mut problem = StepProblem::new(world, mesh, &dofs, setup, &x).map_err(err)?;
-        problem.initial_guess(&x).map_err(err)?;
-        let solver = &self.model.scene.solver;
-        let mut snes =
-            Snes::new(world, solver.newton_rtol, solver.newton_max_it as usize).map_err(err)?;
-        let stats = snes
-            .solve(&mut problem, &x, &jac)
-            .map_err(|e| format!("step {step}: {}", e.message))?;
-        let du = problem.local_displacements(x.as_ref()).map_err(err)?;
-        let states = problem
-            .elements(&du)
-            .map_err(|e| format!("step {step}: {e}"))?
-            .into_iter()
-            .map(|e| e.states)
-            .collect();
-        drop(problem);
-        Ok(Solved {
-            dofs,
-            du,
-            states,
-            newton_iterations: stats.newton_iterations,
-            residual_norm: stats.residual_norm,
-        })
-    }
-
-    /// Collective. Moves the particles and carries the new Gauss states to them.
-    pub fn update(
-        &mut self,
-        world: &Comm,
-        mesh: &LocalMesh,
-        solved: Solved,
-    ) -> Result<StepReport, String> {
-        for i in 0..self.particles.len() {
-            let node = solved.dofs.node_of_point[i];
-            if node != u32::MAX {
-                let d = solved.du[node as usize];
-                for (c, dc) in d.iter().enumerate() {
-                    self.particles.position[i][c] += dc;
-                    self.particles.displacement[i][c] += dc;
-                }
-            }
-        }
-        self.particles.state = recover_at_particles(mesh, &solved.states, &self.particles.state);
-        self.tri_states = TriStates::new(mesh, solved.states);
-        self.header.step += 1;
-        self.header.load_factor = self.model.load_factor(self.header.step);
-        let counts = sum_f64(
-            world,
-            &[self.particles.len() as f64, mesh.n_owned_tris() as f64],
-        );
-        Ok(StepReport {
-            newton_iterations: solved.newton_iterations,
-            residual_norm: solved.residual_norm,
-            particles: counts[0] as u64,
-            triangles: counts[1] as u64,
-        })
-    }
-
     /// Collective. The global measures history.csv needs.
     pub fn measures(&self, world: &Comm) -> Measures {
-        let mut local = [0.0; 2];
+        let mut tip = [0.0; 2];
         if let Some(&gid) = self.header.tracked_gids.first() {
             if let Ok(i) = self.particles.gid.binary_search(&gid) {
-                local = self.particles.displacement[i];
+                tip = self.particles.displacement[i];
             }
         }
-        let u = sum_f64(world, &local);
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for i in 0..self.particles.len() {
+            if self
+                .model
+                .in_first_prescribed(self.particles.reference_position(i))
+            {
+                lo = lo.min(self.particles.position[i][0]);
+                hi = hi.max(self.particles.position[i][0]);
+            }
+        }
+        let s = sum_f64(
+            world,
+            &[
+                tip[0],
+                tip[1],
+                self.last_reaction[0],
+                self.last_reaction[1],
+                self.last_area,
+            ],
+        );
+        let width = max_f64(world, hi) + max_f64(world, -lo);
         Measures {
             load_factor: self.header.load_factor,
-            tracked_displacement: [u[0], u[1]],
+            tracked_displacement: [s[0], s[1]],
+            reaction: [s[2], s[3]],
+            area: s[4],
+            driven_width: width,
         }
     }
 
@@ -333,98 +253,6 @@ impl Simulation {
             Particles::from_records(gid, &rec, fl.into_iter().map(|f| f as u32).collect());
         self.tri_states = TriStates::default();
         Ok(())
-    }
-}
-
-/// history.csv and checkpoints under the run's output folder.
-pub struct Output {
-    dir: PathBuf,
-    history: Option<HistoryFile>,
-}
-
-impl Output {
-    /// Collective. Creates `DIR` (rank 0) and opens the history, keeping rows of earlier runs up to
-    /// the restart step.
-    pub fn open(world: &Comm, sim: &Simulation, dir: &Path) -> Result<Output, String> {
-        let mut local = None;
-        let mut history = None;
-        if world.rank() == 0 {
-            match std::fs::create_dir_all(dir.join("checkpoints"))
-                .map_err(|e| format!("{}: {e}", dir.display()))
-                .and_then(|_| HistoryFile::open(dir, sim.scene().history.kind, sim.step()))
-            {
-                Ok(h) => history = Some(h),
-                Err(e) => local = Some(e),
-            }
-        }
-        if let Some(e) = pfem_partition::agree_on_error(world, local) {
-            return Err(e);
-        }
-        Ok(Output {
-            dir: dir.to_path_buf(),
-            history,
-        })
-    }
-
-    /// Collective. Appends the step's row.
-    pub fn record(&mut self, world: &Comm, sim: &Simulation) -> Result<(), String> {
-        let m = sim.measures(world);
-        let mut local = None;
-        if let Some(h) = self.history.as_mut() {
-            if let Err(e) = history::row(sim.scene(), &m).and_then(|r| h.append(sim.step(), &r)) {
-                local = Some(e);
-            }
-        }
-        match pfem_partition::agree_on_error(world, local) {
-            Some(e) => Err(e),
-            None => Ok(()),
-        }
-    }
-
-    /// Collective. Checkpoint every K steps (scene setting) and at the last step of the run.
-    pub fn checkpoint_if_due(
-        &mut self,
-        world: &Comm,
-        sim: &Simulation,
-        last: u64,
-    ) -> Result<(), String> {
-        let every = sim.scene().output.checkpoint_every as u64;
-        let step = sim.step();
-        if step != last && (every == 0 || !step.is_multiple_of(every)) {
-            return Ok(());
-        }
-        let path = self
-            .dir
-            .join("checkpoints")
-            .join(format!("step_{step:06}.h5"));
-        sim.write_checkpoint(world, &path)?;
-        if world.rank() == 0 {
-            prune_checkpoints(
-                &self.dir.join("checkpoints"),
-                sim.scene().output.checkpoint_keep as usize,
-            );
-        }
-        Ok(())
-    }
-}
-
-/// Keeps the newest `keep` checkpoints.
-fn prune_checkpoints(dir: &Path, keep: usize) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    let mut names: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.file_name()
-                .and_then(|n| n.to_str())
-                .is_some_and(|n| n.starts_with("step_") && n.ends_with(".h5"))
-        })
-        .collect();
-    names.sort();
-    let n = names.len();
-    for p in names.into_iter().take(n.saturating_sub(keep.max(1))) {
-        let _ = std::fs::remove_file(p);
     }
 }
 

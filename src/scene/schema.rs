@@ -247,6 +247,9 @@ pub struct Output {
     pub checkpoint_every: u32,
     /// Number of most recent checkpoints kept on disk, >= 1. Default 3.
     pub checkpoint_keep: u32,
+    /// ParaView output (`DIR/fields.xdmf`) every this many steps; 0 = only the last step of a
+    /// run. Default 0.
+    pub fields_every: u32,
 }
 
 impl Default for Output {
@@ -254,6 +257,7 @@ impl Default for Output {
         Output {
             checkpoint_every: 0,
             checkpoint_keep: 3,
+            fields_every: 0,
         }
     }
 }
@@ -266,6 +270,19 @@ pub struct Solver {
     pub newton_max_it: u32,
     /// Relative residual tolerance, 0 < newton_rtol < 1. Default 1e-9.
     pub newton_rtol: f64,
+    /// `"auto"` (default: `"p2p1"` for `"tresca"`, `"p2"` otherwise), `"p2"` (6-node displacement
+    /// triangles) or `"p2p1"` (Taylor–Hood mixed u–p: P2 displacement, P1 pressure).
+    pub element: ElementChoice,
+}
+
+/// `solver.element`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ElementChoice {
+    #[default]
+    Auto,
+    P2,
+    P2p1,
 }
 
 impl Default for Solver {
@@ -273,6 +290,7 @@ impl Default for Solver {
         Solver {
             newton_max_it: 25,
             newton_rtol: 1e-9,
+            element: ElementChoice::Auto,
         }
     }
 }

@@ -19,8 +19,12 @@ pub struct DofMap {
     pub edges: Vec<[u32; 2]>,
     /// Per triangle: its 6 nodes (3 vertices CCW, then edges 01, 12, 20).
     pub tri_nodes: Vec<[u32; 6]>,
-    /// Global dof of each node's x component (y is +1).
+    /// Global number of each node's first dof (ux; then uy, then p at a vertex of a mixed mesh).
     pub node_global: Vec<usize>,
+    /// Offset of each node's first dof in the local (owned + ghost) vector.
+    pub node_local: Vec<usize>,
+    /// Dofs per vertex node: 2, or 3 with a pressure unknown (mixed u–p elements).
+    pub vertex_dofs: usize,
     /// Whether this rank owns the node (and so its two rows).
     pub node_owned: Vec<bool>,
     /// Local point behind each vertex node (`u32::MAX` for edge nodes).
@@ -31,8 +35,9 @@ pub struct DofMap {
 }
 
 impl DofMap {
-    /// Collective. Numbers the dofs of `mesh`.
-    pub fn build(comm: &Comm, mesh: &LocalMesh) -> Result<DofMap, PartitionError> {
+    /// Collective. Numbers the dofs of `mesh`; `pressure` adds a pressure unknown at every vertex.
+    pub fn build(comm: &Comm, mesh: &LocalMesh, pressure: bool) -> Result<DofMap, PartitionError> {
+        let vertex_dofs = if pressure { 3 } else { 2 };
         let np = mesh.points.len();
         let mut used = vec![false; np];
         for t in &mesh.tris {
@@ -96,16 +101,30 @@ impl DofMap {
                 *n = node_of_edge[*n as usize];
             }
         }
-        let n_owned_nodes = node_owned.iter().filter(|&&o| o).count();
-        let (first_node, n_global_nodes) = exscan_u64(comm, n_owned_nodes as u64);
+        let ndof = |n: usize| {
+            if n < n_vertex_nodes as usize {
+                vertex_dofs
+            } else {
+                2
+            }
+        };
+        let n_owned_dofs: usize = (0..node_owned.len())
+            .filter(|&n| node_owned[n])
+            .map(ndof)
+            .sum();
+        let (first_dof, n_global_dofs) = exscan_u64(comm, n_owned_dofs as u64);
         let mut node_global = vec![usize::MAX; node_owned.len()];
-        let mut owned_number: HashMap<[u64; 2], u64> = HashMap::with_capacity(n_owned_nodes);
-        let mut next = first_node;
+        let mut node_local = Vec::with_capacity(node_owned.len());
+        let mut owned_number: HashMap<[u64; 2], u64> = HashMap::with_capacity(node_owned.len());
+        let mut next = first_dof;
+        let mut local = 0;
         for (n, &own) in node_owned.iter().enumerate() {
+            node_local.push(local);
+            local += ndof(n);
             if own {
-                node_global[n] = 2 * next as usize;
-                owned_number.insert(keys[n], 2 * next);
-                next += 1;
+                node_global[n] = next as usize;
+                owned_number.insert(keys[n], next);
+                next += ndof(n) as u64;
             }
         }
         let mut requests = Vec::new();
@@ -139,9 +158,11 @@ impl DofMap {
             node_global,
             node_owned,
             node_point,
-            n_owned_dofs: 2 * n_owned_nodes,
-            first_dof: 2 * first_node as usize,
-            n_global_dofs: 2 * n_global_nodes as usize,
+            node_local,
+            vertex_dofs,
+            n_owned_dofs,
+            first_dof: first_dof as usize,
+            n_global_dofs: n_global_dofs as usize,
         })
     }
 
@@ -149,9 +170,20 @@ impl DofMap {
         self.node_global.len()
     }
 
-    /// Global indices of the local vector (2 per node, node order): what the scatter gathers.
+    /// Dofs of node `n`.
+    pub fn ndof(&self, n: usize) -> usize {
+        if self.node_point[n] == u32::MAX {
+            2
+        } else {
+            self.vertex_dofs
+        }
+    }
+
+    /// Global indices of the local vector (node order): what the scatter gathers.
     pub fn local_to_global(&self) -> Vec<usize> {
-        self.node_global.iter().flat_map(|&g| [g, g + 1]).collect()
+        (0..self.n_nodes())
+            .flat_map(|n| (0..self.ndof(n)).map(move |c| self.node_global[n] + c))
+            .collect()
     }
 
     /// Exact nonzero counts per owned row in the diagonal and off-diagonal blocks, from the mesh
@@ -173,12 +205,19 @@ impl DofMap {
             }
             c.sort_unstable();
             c.dedup();
-            let nd = c.iter().filter(|&&n| self.node_owned[n as usize]).count() as i32;
-            let no = c.len() as i32 - nd;
+            let (mut nd, mut no) = (0, 0);
+            for &n in c.iter() {
+                let k = self.ndof(n as usize) as i32;
+                if self.node_owned[n as usize] {
+                    nd += k;
+                } else {
+                    no += k;
+                }
+            }
             let row = self.node_global[r] - self.first_dof;
-            for k in 0..2 {
-                d[row + k] = 2 * nd;
-                o[row + k] = 2 * no;
+            for k in 0..self.ndof(r) {
+                d[row + k] = nd;
+                o[row + k] = no;
             }
         }
         (d, o)

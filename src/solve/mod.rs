@@ -7,4 +7,4 @@ pub mod problem;
 
 pub use constraints::Constraints;
 pub use dofs::DofMap;
-pub use problem::{StepProblem, StepSetup};
+pub use problem::{Kernel, StepProblem, StepSetup};

@@ -4,7 +4,8 @@
 //! same order whatever the partition.
 
 use super::{Constraints, DofMap};
-use crate::fem::element::{p2_element, ElementOutput, N_DOFS};
+use crate::fem::element::p2_element;
+use crate::fem::mixed::p2p1_element;
 use crate::fem::p2::straight_sided;
 use crate::material::{GaussState, Material};
 use crate::mesh::LocalMesh;
@@ -12,15 +13,34 @@ use crate::petsc::snes::{CallbackError, NonlinearProblem};
 use crate::petsc::{matrix::MatRef, PVec, PetscError, Scatter, VecRef};
 use pfem_partition::{agree_on_error, Comm};
 
+/// The element family of a step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Kernel {
+    /// 6-node displacement triangle (compressible solids).
+    P2,
+    /// Taylor–Hood P2–P1 with vertex pressures for nearly incompressible and plastically
+    /// incompressible soil. The pressure unknown is p / `scale` (scale = G/h), which has the size
+    /// of a displacement and keeps the saddle point well conditioned.
+    P2P1 { bulk: f64, scale: f64 },
+}
+
 /// What a step needs besides the mesh.
 pub struct StepSetup<'a> {
     pub material: &'a dyn Material,
+    pub kernel: Kernel,
     /// Cauchy state at the start of the step, per local triangle and Gauss point.
     pub states_n: &'a [[GaussState; 3]],
     pub body_force: [f64; 2],
     pub constraints: &'a Constraints,
     /// Total external point forces on owned nodes at the end of the step: (node, force).
     pub point_loads: Vec<(u32, [f64; 2])>,
+}
+
+/// One element's contribution: residual, row-major tangent, states; dof order as the element's.
+pub struct ElementResult {
+    pub residual: Vec<f64>,
+    pub tangent: Vec<f64>,
+    pub states: [GaussState; 3],
 }
 
 pub struct StepProblem<'a> {
@@ -31,6 +51,8 @@ pub struct StepProblem<'a> {
     scatter: Scatter,
     /// Start-of-step nodes of every triangle (straight sided).
     geometry: Vec<[[f64; 2]; 6]>,
+    /// Local-vector index of every element dof, per triangle.
+    element_dofs: Vec<Vec<usize>>,
 }
 
 impl<'a> StepProblem<'a> {
@@ -46,12 +68,21 @@ impl<'a> StepProblem<'a> {
         let geometry = mesh
             .tris
             .iter()
-            .map(|t| {
-                straight_sided(&[
-                    mesh.points[t[0] as usize],
-                    mesh.points[t[1] as usize],
-                    mesh.points[t[2] as usize],
-                ])
+            .map(|t| straight_sided(&t.map(|v| mesh.points[v as usize])))
+            .collect();
+        let mixed = matches!(setup.kernel, Kernel::P2P1 { .. });
+        let element_dofs = dofs
+            .tri_nodes
+            .iter()
+            .map(|nodes| {
+                let mut d: Vec<usize> = nodes
+                    .iter()
+                    .flat_map(|&n| [dofs.node_local[n as usize], dofs.node_local[n as usize] + 1])
+                    .collect();
+                if mixed {
+                    d.extend(nodes[..3].iter().map(|&n| dofs.node_local[n as usize] + 2));
+                }
+                d
             })
             .collect();
         Ok(StepProblem {
@@ -61,99 +92,167 @@ impl<'a> StepProblem<'a> {
             setup,
             scatter,
             geometry,
+            element_dofs,
         })
     }
 
-    /// Initial iterate: zero, except prescribed step displacements.
-    pub fn initial_guess(&self, x: &PVec) -> Result<(), PetscError> {
+    fn pressure_scale(&self) -> f64 {
+        match self.setup.kernel {
+            Kernel::P2 => 1.0,
+            Kernel::P2P1 { scale, .. } => scale,
+        }
+    }
+
+    /// Initial iterate: the predictor per node (the last step's increment, scaled pressures) with
+    /// prescribed step displacements imposed.
+    pub fn initial_guess(
+        &self,
+        x: &PVec,
+        predictor: impl Fn(usize) -> [f64; 3],
+    ) -> Result<(), PetscError> {
         let first = self.dofs.first_dof;
+        let scale = self.pressure_scale();
         x.as_ref().write(|xa| {
-            xa.fill(0.0);
-            for (n, f) in self
-                .dofs
-                .node_owned
-                .iter()
-                .zip(&self.setup.constraints.fixed)
-                .enumerate()
-                .filter_map(|(n, (&o, f))| o.then_some((n, f)))
-            {
-                for c in 0..2 {
-                    if let Some(g) = f[c] {
-                        xa[self.dofs.node_global[n] - first + c] = g;
-                    }
+            for n in 0..self.dofs.n_nodes() {
+                if !self.dofs.node_owned[n] {
+                    continue;
+                }
+                let g = self.dofs.node_global[n] - first;
+                let guess = predictor(n);
+                for c in 0..self.dofs.ndof(n) {
+                    xa[g + c] = match (c, self.setup.constraints.fixed[n].get(c).copied().flatten())
+                    {
+                        (2, _) => guess[2] / scale,
+                        (_, Some(v)) => v,
+                        _ => guess[c],
+                    };
                 }
             }
         })
     }
 
-    /// Collective. Step displacement of every local node (owned and ghost), from the solution.
-    pub fn local_displacements(&self, x: VecRef) -> Result<Vec<[f64; 2]>, PetscError> {
-        self.scatter
-            .gather(x, |l| l.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+    /// Collective. The local vector (owned and ghost dofs) of a global one.
+    pub fn local_values(&self, x: VecRef) -> Result<Vec<f64>, PetscError> {
+        self.scatter.gather(x, |l| l.to_vec())
     }
 
-    /// Evaluates every local triangle at step displacement `du` (local node order).
-    pub fn elements(&self, du: &[[f64; 2]]) -> Result<Vec<ElementOutput>, String> {
+    /// Step displacement of every local node.
+    pub fn node_displacements(&self, local: &[f64]) -> Vec<[f64; 2]> {
+        self.dofs
+            .node_local
+            .iter()
+            .map(|&o| [local[o], local[o + 1]])
+            .collect()
+    }
+
+    /// Evaluates every local triangle at the local vector `local`.
+    pub fn elements(&self, local: &[f64]) -> Result<Vec<ElementResult>, String> {
+        let s = &self.setup;
         let mut out = Vec::with_capacity(self.mesh.tris.len());
-        for (t, nodes) in self.dofs.tri_nodes.iter().enumerate() {
-            let mut d = [[0.0; 2]; 6];
-            for (k, &n) in nodes.iter().enumerate() {
-                d[k] = du[n as usize];
-            }
-            let e = p2_element(
-                &self.geometry[t],
-                &d,
-                &self.setup.states_n[t],
-                self.setup.material,
-                self.setup.body_force,
-            )
-            .map_err(|e| format!("triangle {:?}: {e}", self.mesh.tri_key(t)))?;
-            out.push(e);
+        for (t, dofs) in self.element_dofs.iter().enumerate() {
+            let du: [[f64; 2]; 6] =
+                std::array::from_fn(|k| [local[dofs[2 * k]], local[dofs[2 * k + 1]]]);
+            let result = match s.kernel {
+                Kernel::P2 => p2_element(
+                    &self.geometry[t],
+                    &du,
+                    &s.states_n[t],
+                    s.material,
+                    s.body_force,
+                )
+                .map(|e| ElementResult {
+                    residual: e.residual.to_vec(),
+                    tangent: e.tangent.as_flattened().to_vec(),
+                    states: e.states,
+                }),
+                Kernel::P2P1 { bulk, scale } => {
+                    let p: [f64; 3] = std::array::from_fn(|k| scale * local[dofs[12 + k]]);
+                    p2p1_element(
+                        &self.geometry[t],
+                        &du,
+                        &p,
+                        &s.states_n[t],
+                        s.material,
+                        bulk,
+                        s.body_force,
+                    )
+                    .map(|e| {
+                        let e = e.with_pressure_scale(scale);
+                        ElementResult {
+                            residual: e.residual.to_vec(),
+                            tangent: e.tangent.as_flattened().to_vec(),
+                            states: e.states,
+                        }
+                    })
+                }
+            };
+            out.push(result.map_err(|e| format!("triangle {:?}: {e}", self.mesh.tri_key(t)))?);
         }
         Ok(out)
     }
 
     /// Collective: all ranks learn whether any element failed, so they fail together.
-    fn evaluate(&self, x: VecRef) -> Result<Vec<ElementOutput>, CallbackError> {
-        let du = self
-            .local_displacements(x)
+    fn evaluate(&self, x: VecRef) -> Result<(Vec<f64>, Vec<ElementResult>), CallbackError> {
+        let local = self
+            .local_values(x)
             .map_err(|e| CallbackError::Fatal(e.to_string()))?;
-        let local = self.elements(&du);
-        let err = local.as_ref().err().cloned();
-        match agree_on_error(self.comm, err) {
-            None => local.map_err(CallbackError::Domain),
+        let elems = self.elements(&local);
+        match agree_on_error(self.comm, elems.as_ref().err().cloned()) {
+            None => Ok((local, elems.map_err(CallbackError::Domain)?)),
             Some(msg) => Err(CallbackError::Domain(msg)),
         }
     }
 
-    fn owned_row(&self, node: u32, c: usize) -> Option<usize> {
-        let n = node as usize;
-        (self.dofs.node_owned[n] && self.setup.constraints.fixed[n][c].is_none())
-            .then(|| self.dofs.node_global[n] - self.dofs.first_dof + c)
+    /// The owned, unconstrained row of element dof `k` of triangle `t` (local-vector index
+    /// `dofs[k]`), if any.
+    fn free_row(&self, t: usize, k: usize) -> Option<usize> {
+        let node = self.dofs.tri_nodes[t][if k < 12 { k / 2 } else { k - 12 }] as usize;
+        let c = if k < 12 { k % 2 } else { 2 };
+        if !self.dofs.node_owned[node] || (c < 2 && self.setup.constraints.fixed[node][c].is_some())
+        {
+            return None;
+        }
+        Some(self.dofs.node_global[node] - self.dofs.first_dof + c)
+    }
+
+    /// Reaction forces: the internal force on the constrained owned dofs of the nodes `select`
+    /// picks, summed per component.
+    pub fn reaction(&self, elems: &[ElementResult], select: impl Fn(usize) -> bool) -> [f64; 2] {
+        let mut r = [0.0; 2];
+        for (t, e) in elems.iter().enumerate() {
+            for k in 0..12 {
+                let node = self.dofs.tri_nodes[t][k / 2] as usize;
+                let c = k % 2;
+                if self.dofs.node_owned[node]
+                    && self.setup.constraints.fixed[node][c].is_some()
+                    && select(node)
+                {
+                    r[c] += e.residual[k];
+                }
+            }
+        }
+        r
     }
 }
 
 impl NonlinearProblem for StepProblem<'_> {
     fn residual(&mut self, x: VecRef, f: VecRef) -> Result<(), CallbackError> {
-        let elems = self.evaluate(x)?;
-        let xs: Vec<f64> = x
-            .read(|a| a.to_vec())
-            .map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        let (local, elems) = self.evaluate(x)?;
+        let first = self.dofs.first_dof;
         f.write(|fa| {
             fa.fill(0.0);
-            for (nodes, e) in self.dofs.tri_nodes.iter().zip(&elems) {
-                for (k, &n) in nodes.iter().enumerate() {
-                    for c in 0..2 {
-                        if let Some(row) = self.owned_row(n, c) {
-                            fa[row] += e.residual[2 * k + c];
-                        }
+            for (t, e) in elems.iter().enumerate() {
+                for (k, r) in e.residual.iter().enumerate() {
+                    if let Some(row) = self.free_row(t, k) {
+                        fa[row] += r;
                     }
                 }
             }
             for &(n, force) in &self.setup.point_loads {
+                let n = n as usize;
                 for (c, fc) in force.iter().enumerate() {
-                    if let Some(row) = self.owned_row(n, c) {
-                        fa[row] -= fc;
+                    if self.setup.constraints.fixed[n][c].is_none() {
+                        fa[self.dofs.node_global[n] - first + c] -= fc;
                     }
                 }
             }
@@ -163,8 +262,8 @@ impl NonlinearProblem for StepProblem<'_> {
                 }
                 for (c, g) in fx.iter().enumerate() {
                     if let Some(g) = g {
-                        let row = self.dofs.node_global[n] - self.dofs.first_dof + c;
-                        fa[row] = xs[row] - g;
+                        fa[self.dofs.node_global[n] - first + c] =
+                            local[self.dofs.node_local[n] + c] - g;
                     }
                 }
             }
@@ -173,38 +272,29 @@ impl NonlinearProblem for StepProblem<'_> {
     }
 
     fn jacobian(&mut self, x: VecRef, j: MatRef) -> Result<(), CallbackError> {
-        let elems = self.evaluate(x)?;
+        let (_, elems) = self.evaluate(x)?;
         let fatal = |e: PetscError| CallbackError::Fatal(e.to_string());
+        let l2g = self.dofs.local_to_global();
         j.zero_entries().map_err(fatal)?;
-        let mut rows = Vec::with_capacity(N_DOFS);
-        let mut row_k = Vec::with_capacity(N_DOFS);
-        let mut vals = Vec::with_capacity(N_DOFS * N_DOFS);
-        for (nodes, e) in self.dofs.tri_nodes.iter().zip(&elems) {
-            let cols: Vec<i32> = nodes
+        let mut rows = Vec::new();
+        let mut vals = Vec::new();
+        for (t, e) in elems.iter().enumerate() {
+            let cols: Vec<i32> = self.element_dofs[t]
                 .iter()
-                .flat_map(|&n| {
-                    let g = self.dofs.node_global[n as usize] as i32;
-                    [g, g + 1]
-                })
+                .map(|&d| l2g[d] as i32)
                 .collect();
+            let n = cols.len();
             rows.clear();
-            row_k.clear();
-            for (k, &n) in nodes.iter().enumerate() {
-                for c in 0..2 {
-                    if self.owned_row(n, c).is_some() {
-                        rows.push(self.dofs.node_global[n as usize] as i32 + c as i32);
-                        row_k.push(2 * k + c);
-                    }
+            vals.clear();
+            for k in 0..n {
+                if self.free_row(t, k).is_some() {
+                    rows.push(cols[k]);
+                    vals.extend_from_slice(&e.tangent[k * n..(k + 1) * n]);
                 }
             }
-            if rows.is_empty() {
-                continue;
+            if !rows.is_empty() {
+                j.add_values(&rows, &cols, &vals).map_err(fatal)?;
             }
-            vals.clear();
-            for &r in &row_k {
-                vals.extend_from_slice(&e.tangent[r]);
-            }
-            j.add_values(&rows, &cols, &vals).map_err(fatal)?;
         }
         for (n, fx) in self.setup.constraints.fixed.iter().enumerate() {
             if !self.dofs.node_owned[n] {

@@ -1,0 +1,161 @@
+//! What a run leaves in its output folder: history.csv, ParaView fields, checkpoints.
+
+use super::Simulation;
+use crate::history::{self, HistoryFile};
+use crate::mesh::LocalMesh;
+use crate::output::{Field, FieldsWriter, Frame};
+use mpi::traits::Communicator;
+use pfem_partition::Comm;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// history.csv and checkpoints under the run's output folder.
+pub struct Output {
+    dir: PathBuf,
+    history: Option<HistoryFile>,
+    fields: FieldsWriter,
+}
+
+impl Output {
+    /// Collective. Creates `DIR` (rank 0) and opens the history, keeping rows of earlier runs up to
+    /// the restart step.
+    pub fn open(world: &Comm, sim: &Simulation, dir: &Path) -> Result<Output, String> {
+        let mut local = None;
+        let mut history = None;
+        if world.rank() == 0 {
+            match std::fs::create_dir_all(dir.join("checkpoints"))
+                .map_err(|e| format!("{}: {e}", dir.display()))
+                .and_then(|_| HistoryFile::open(dir, sim.scene().history.kind, sim.step()))
+            {
+                Ok(h) => history = Some(h),
+                Err(e) => local = Some(e),
+            }
+        }
+        if let Some(e) = pfem_partition::agree_on_error(world, local) {
+            return Err(e);
+        }
+        let fields = FieldsWriter::open(world, dir, sim.step()).map_err(|e| e.to_string())?;
+        Ok(Output {
+            dir: dir.to_path_buf(),
+            history,
+            fields,
+        })
+    }
+
+    /// Collective. ParaView fields every `output.fields_every` steps and at the last step of the
+    /// run: per particle displacement, step increment, ε_q^p, stresses, pressure and owning rank,
+    /// on the mesh the step was solved on.
+    pub fn fields_if_due(
+        &mut self,
+        world: &Comm,
+        sim: &Simulation,
+        mesh: &LocalMesh,
+        last: u64,
+    ) -> Result<(), String> {
+        let every = sim.scene().output.fields_every as u64;
+        let step = sim.step();
+        if step != last && (every == 0 || !step.is_multiple_of(every)) {
+            return Ok(());
+        }
+        let p = &sim.particles;
+        let col = |k: usize| p.state.iter().map(|s| s[k]).collect::<Vec<f64>>();
+        let triangles: Vec<[u64; 3]> = (0..mesh.tris.len())
+            .filter(|&t| mesh.tri_owned[t])
+            .map(|t| mesh.tri_key(t))
+            .collect();
+        let owners: HashMap<u64, i32> = sim
+            .ghosts
+            .gid
+            .iter()
+            .copied()
+            .zip(sim.ghosts.owner.iter().copied())
+            .collect();
+        let owner_of = |g: u64| owners.get(&g).copied();
+        let frame = Frame {
+            step,
+            time: sim.load_factor(),
+            gid: &p.gid,
+            position: &p.position,
+            point_data: vec![
+                Field::VectorRef("displacement", &p.displacement),
+                Field::VectorRef("incremental_displacement", &p.increment),
+                Field::Scalar("eps_q", col(8)),
+                Field::Scalar("sigma_xx", col(0)),
+                Field::Scalar("sigma_yy", col(1)),
+                Field::Scalar("tau_xy", col(3)),
+                Field::Scalar(
+                    "pressure",
+                    p.state
+                        .iter()
+                        .map(|s| -(s[0] + s[1] + s[2]) / 3.0)
+                        .collect(),
+                ),
+                Field::Scalar("rank", vec![world.rank() as f64; p.len()]),
+            ],
+            triangles: &triangles,
+            owner_of: &owner_of,
+        };
+        self.fields.write(world, &frame).map_err(|e| e.to_string())
+    }
+
+    /// Collective. Appends the step's row.
+    pub fn record(&mut self, world: &Comm, sim: &Simulation) -> Result<(), String> {
+        let m = sim.measures(world);
+        let mut local = None;
+        if let Some(h) = self.history.as_mut() {
+            if let Err(e) = history::row(sim.scene(), &m).and_then(|r| h.append(sim.step(), &r)) {
+                local = Some(e);
+            }
+        }
+        match pfem_partition::agree_on_error(world, local) {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    /// Collective. Checkpoint every K steps (scene setting) and at the last step of the run.
+    pub fn checkpoint_if_due(
+        &mut self,
+        world: &Comm,
+        sim: &Simulation,
+        last: u64,
+    ) -> Result<(), String> {
+        let every = sim.scene().output.checkpoint_every as u64;
+        let step = sim.step();
+        if step != last && (every == 0 || !step.is_multiple_of(every)) {
+            return Ok(());
+        }
+        let path = self
+            .dir
+            .join("checkpoints")
+            .join(format!("step_{step:06}.h5"));
+        sim.write_checkpoint(world, &path)?;
+        if world.rank() == 0 {
+            prune_checkpoints(
+                &self.dir.join("checkpoints"),
+                sim.scene().output.checkpoint_keep as usize,
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Keeps the newest `keep` checkpoints.
+fn prune_checkpoints(dir: &Path, keep: usize) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let mut names: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("step_") && n.ends_with(".h5"))
+        })
+        .collect();
+    names.sort();
+    let n = names.len();
+    for p in names.into_iter().take(n.saturating_sub(keep.max(1))) {
+        let _ = std::fs::remove_file(p);
+    }
+}

@@ -1,0 +1,196 @@
+//! The solve and update phases: one implicit updated-Lagrangian increment by Newton (PETSc SNES),
+//! then moving the particles and carrying the new Gauss states to them.
+
+use super::{Simulation, StepReport};
+use crate::mapping::{recover_at_particles, TriStates};
+use crate::material::GaussState;
+use crate::mesh::LocalMesh;
+use crate::petsc::{Mat, PVec, Petsc, Snes};
+use crate::solve::{Constraints, DofMap, StepProblem, StepSetup};
+use pfem_partition::{sum_f64, Comm};
+
+/// The solved step, before particles move.
+pub struct Solved {
+    dofs: DofMap,
+    du: Vec<[f64; 2]>,
+    states: Vec<[GaussState; 3]>,
+    reaction: [f64; 2],
+    newton_iterations: usize,
+    residual_norm: f64,
+}
+
+fn err<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+/// Pressure (compression positive) of a particle state.
+fn pressure(state: &[f64; GaussState::LEN]) -> f64 {
+    -(state[0] + state[1] + state[2]) / 3.0
+}
+
+impl Simulation {
+    fn point_value<T: Copy>(&self, mesh: &LocalMesh, p: usize, owned: &[T], ghost: &[T]) -> T {
+        if p < mesh.n_owned {
+            owned[p]
+        } else {
+            ghost[p - mesh.n_owned]
+        }
+    }
+
+    /// Collective. One implicit updated-Lagrangian increment by Newton (PETSc SNES).
+    pub fn solve(
+        &self,
+        world: &Comm,
+        petsc: &Petsc,
+        mesh: &LocalMesh,
+        states_n: &[[GaussState; 3]],
+    ) -> Result<Solved, String> {
+        let _ = petsc;
+        let step = self.header.step + 1;
+        let dofs = DofMap::build(world, mesh, self.model.mixed()).map_err(err)?;
+        let constraints = Constraints::build(&dofs, |p| {
+            self.model.step_bc(self.reference_position(mesh, p))
+        });
+        let factor = self.model.load_factor(step);
+        let mut point_loads = Vec::new();
+        for (load, &gid) in self
+            .model
+            .scene
+            .point_load
+            .iter()
+            .zip(&self.header.tracked_gids)
+        {
+            if let Ok(i) = self.particles.gid.binary_search(&gid) {
+                let node = dofs.node_of_point[i];
+                if node != u32::MAX {
+                    point_loads.push((node, [factor * load.force[0], factor * load.force[1]]));
+                }
+            }
+        }
+        let setup = StepSetup {
+            material: self.model.material.as_ref(),
+            kernel: self.model.kernel,
+            states_n,
+            body_force: self.model.body_force,
+            constraints: &constraints,
+            point_loads,
+        };
+        let x = PVec::mpi(world, dofs.n_owned_dofs).map_err(err)?;
+        let (d_nnz, o_nnz) = dofs.preallocation();
+        let jac = Mat::aij(world, dofs.n_owned_dofs, &d_nnz, &o_nnz).map_err(err)?;
+        let mut problem = StepProblem::new(world, mesh, &dofs, setup, &x).map_err(err)?;
+        // Predictor: the last step's increment (a proportional step's best guess, which also keeps
+        // Newton off the zero-energy shear-band modes of a plastic limit state) and the current
+        // pressure.
+        let inc =
+            |p: usize| self.point_value(mesh, p, &self.particles.increment, &self.ghosts.increment);
+        let state = |p: usize| self.point_value(mesh, p, &self.particles.state, &self.ghosts.state);
+        problem
+            .initial_guess(&x, |n| {
+                let p = dofs.node_point[n];
+                if p != u32::MAX {
+                    let (d, s) = (inc(p as usize), state(p as usize));
+                    [d[0], d[1], pressure(&s)]
+                } else {
+                    let [a, b] = dofs.edges[n - (dofs.n_nodes() - dofs.edges.len())];
+                    let (da, db) = (inc(a as usize), inc(b as usize));
+                    [0.5 * (da[0] + db[0]), 0.5 * (da[1] + db[1]), 0.0]
+                }
+            })
+            .map_err(err)?;
+        let solver = &self.model.scene.solver;
+        let line_search = if self.model.plastic() { "bt" } else { "basic" };
+        let mut snes = Snes::new(
+            world,
+            solver.newton_rtol,
+            solver.newton_max_it as usize,
+            line_search,
+        )
+        .map_err(err)?;
+        let stats = snes
+            .solve(&mut problem, &x, &jac)
+            .map_err(|e| format!("step {step}: {}", e.message))?;
+        let local = problem.local_values(x.as_ref()).map_err(err)?;
+        let elems = problem
+            .elements(&local)
+            .map_err(|e| format!("step {step}: {e}"))?;
+        let n_vertex = dofs.n_nodes() - dofs.edges.len();
+        let driven = |n: usize| {
+            let pts: Vec<u32> = if n < n_vertex {
+                vec![dofs.node_point[n]]
+            } else {
+                dofs.edges[n - n_vertex].to_vec()
+            };
+            pts.iter().all(|&p| {
+                self.model
+                    .in_first_prescribed(self.reference_position(mesh, p as usize))
+            })
+        };
+        let reaction = problem.reaction(&elems, driven);
+        let du = problem.node_displacements(&local);
+        drop(problem);
+        Ok(Solved {
+            dofs,
+            du,
+            states: elems.into_iter().map(|e| e.states).collect(),
+            reaction,
+            newton_iterations: stats.newton_iterations,
+            residual_norm: stats.residual_norm,
+        })
+    }
+
+    /// Collective. Moves the particles and carries the new Gauss states to them.
+    pub fn update(
+        &mut self,
+        world: &Comm,
+        mesh: &LocalMesh,
+        solved: Solved,
+    ) -> Result<StepReport, String> {
+        for i in 0..self.particles.len() {
+            let node = solved.dofs.node_of_point[i];
+            let d = if node != u32::MAX {
+                solved.du[node as usize]
+            } else {
+                [0.0; 2]
+            };
+            for (c, dc) in d.iter().enumerate() {
+                self.particles.position[i][c] += dc;
+                self.particles.displacement[i][c] += dc;
+            }
+            self.particles.increment[i] = d;
+        }
+        self.particles.state = recover_at_particles(mesh, &solved.states, &self.particles.state);
+        self.tri_states = TriStates::new(mesh, solved.states);
+        self.last_reaction = solved.reaction;
+        self.last_area = owned_area(mesh, &solved.du, &solved.dofs);
+        self.header.step += 1;
+        self.header.load_factor = self.model.load_factor(self.header.step);
+        let counts = sum_f64(
+            world,
+            &[self.particles.len() as f64, mesh.n_owned_tris() as f64],
+        );
+        Ok(StepReport {
+            newton_iterations: solved.newton_iterations,
+            residual_norm: solved.residual_norm,
+            particles: counts[0] as u64,
+            triangles: counts[1] as u64,
+        })
+    }
+}
+
+/// Area of this rank's owned triangles at the end of the step (moved by the vertex increments).
+fn owned_area(mesh: &LocalMesh, du: &[[f64; 2]], dofs: &DofMap) -> f64 {
+    let mut area = 0.0;
+    for (t, tri) in mesh.tris.iter().enumerate() {
+        if !mesh.tri_owned[t] {
+            continue;
+        }
+        let [a, b, c] = tri.map(|v| {
+            let d = du[dofs.node_of_point[v as usize] as usize];
+            let x = mesh.points[v as usize];
+            [x[0] + d[0], x[1] + d[1]]
+        });
+        area += 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+    }
+    area
+}
