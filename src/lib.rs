@@ -16,6 +16,7 @@ pub mod model;
 pub mod output;
 pub mod particles;
 pub mod petsc;
+pub mod plot;
 pub mod run;
 pub mod scene;
 pub mod solve;

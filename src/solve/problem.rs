@@ -286,9 +286,9 @@ impl NonlinearProblem for StepProblem<'_> {
             let n = cols.len();
             rows.clear();
             vals.clear();
-            for k in 0..n {
+            for (k, &col) in cols.iter().enumerate() {
                 if self.free_row(t, k).is_some() {
-                    rows.push(cols[k]);
+                    rows.push(col);
                     vals.extend_from_slice(&e.tangent[k * n..(k + 1) * n]);
                 }
             }

@@ -1,0 +1,86 @@
+//! PNG pictures of a run's output folder `DIR` (`pfem-mpi plot DIR`), written to `DIR/plots/`:
+//!
+//! - `history.png`, from `DIR/history.csv`: the load–displacement curve(s) of the scene kind
+//!   (told by the file's columns) with the reference solutions of `shared/reference.md`:
+//!   - cantilever: u/L and v/L against λ = P L²/(E I), with the Bisshopp–Drucker elastica
+//!     (dashed) and the plane-strain Reissner beam at λ = 2, 5, 10 (crosses);
+//!   - footing: q/cu against z/B, with Prandtl's 2 + π and the deep smooth-strip limit 2 + 2π;
+//!   - block: stress/cu against strain with the Tresca strength 2, above the volume ratio
+//!     against strain with the isochoric 1.
+//!
+//!   The picture is [`CURVE_SIZE`], or [`BLOCK_SIZE`] for a block.
+//! - `FIELD.png` for `FIELD` = `eps_q`, `sigma_yy`, `tau_xy` (and `incremental_displacement`,
+//!   as its length, when the frame has it), when `DIR/fields.xdmf` lists a frame: the field on
+//!   the deformed mesh of the last frame, interpolated linearly in each triangle, axes in metres
+//!   at equal scale, a colour bar ([`colour_map()`], blue = minimum, red = maximum) with the
+//!   minimum and maximum written out, titled with the field and the step. The picture is
+//!   [`CONTOUR_SIZE`], the colour bar its rightmost [`COLOUR_BAR_WIDTH`] pixels.
+//!
+//! Text is drawn with a font compiled into the binary, so plotting needs no system fonts.
+
+mod colour_map;
+mod contour;
+mod curves;
+mod error;
+mod font;
+mod frame;
+mod history;
+mod numbers;
+mod picture;
+mod reference;
+
+use std::path::{Path, PathBuf};
+
+pub use colour_map::colour_map;
+pub use contour::{COLOUR_BAR_WIDTH, CONTOUR_SIZE};
+pub use curves::{BLOCK_SIZE, CURVE_SIZE};
+pub use error::PlotError;
+
+/// Writes `DIR/plots/*.png`: the load–displacement curve(s) of the scene kind with reference
+/// lines, and contour pictures of eps_q, sigma_yy, tau_xy on the deformed mesh of the last
+/// frame (if `DIR/fields.xdmf` exists and lists a frame); see the module documentation.
+/// Returns the files written, history first.
+///
+/// All inputs are read before any picture is written. Errors name the file at fault: a missing
+/// or malformed `history.csv`, a damaged `fields.xdmf`, a frame file that cannot be read or
+/// lacks a field, or a picture that cannot be written.
+pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    font::register()?;
+    let history = history::read(&dir.join("history.csv"))?;
+    let frame = frame::last_frame(dir)?;
+    let mut fields = Vec::new();
+    if let Some(frame) = &frame {
+        for spec in contour::CONTOURS {
+            match frame.field(spec.field)? {
+                Some(values) => fields.push((spec, values)),
+                None if spec.required => {
+                    return Err(PlotError::new(
+                        &frame.path,
+                        format!("no dataset /point_data/{}", spec.field),
+                    ))
+                }
+                None => {}
+            }
+        }
+    }
+
+    let out = dir.join("plots");
+    std::fs::create_dir_all(&out)
+        .map_err(|e| PlotError::new(&out, format!("cannot create folder: {e}")))?;
+    let mut written = Vec::new();
+    let path = out.join("history.png");
+    curves::draw(&history, &path)?;
+    written.push(path);
+    if let Some(frame) = &frame {
+        let when = match frame.time {
+            Some(t) => format!("step {}, t = {}", frame.step, numbers::short(t)),
+            None => format!("step {}", frame.step),
+        };
+        for (spec, values) in &fields {
+            let path = out.join(format!("{}.png", spec.field));
+            contour::draw(frame, values, &format!("{} — {when}", spec.label), &path)?;
+            written.push(path);
+        }
+    }
+    Ok(written)
+}
