@@ -7,6 +7,7 @@ usage:
   pfem-mpi new <NAME|scene.toml> -o case.h5 [--set key=value ...]   write a case file
   pfem-mpi info FILE.h5                                             summarise a case or checkpoint
   pfem-mpi mesh FILE.h5                                             mesh it once, print its fingerprint
+  pfem-mpi plot DIR                                                 draw DIR/plots/*.png from a run's output
   mpirun -n N pfem-mpi FILE.h5 [--out DIR] [--until-step K] [-- PETSc options]
                                                                     run (or continue) an analysis
 built-in scenes: cantilever, footing-shallow, block-compression";
@@ -23,6 +24,9 @@ pub enum Command {
     },
     Mesh {
         file: PathBuf,
+    },
+    Plot {
+        dir: PathBuf,
     },
     Run {
         case: PathBuf,
@@ -64,6 +68,14 @@ pub fn parse(args: &[String]) -> Result<Command, String> {
                 scene: scene.ok_or("new: name a built-in scene or a scene .toml file")?,
                 out: out.ok_or("new: give the case file to write with -o case.h5")?,
                 sets,
+            })
+        }
+        "plot" => {
+            let [dir] = &ours[1..] else {
+                return Err("plot: give exactly one run output folder".into());
+            };
+            Ok(Command::Plot {
+                dir: PathBuf::from(dir),
             })
         }
         "info" | "mesh" => {

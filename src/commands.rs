@@ -29,6 +29,7 @@ pub fn execute(command: Command) -> i32 {
             }
         }
         Command::Mesh { file } => mesh(&world, &file),
+        Command::Plot { dir } => plot(&world, &dir),
         Command::Run {
             case,
             out,
@@ -84,6 +85,18 @@ fn new(world: &Comm, scene: &str, out: &std::path::Path, sets: &[String]) -> Res
 
 fn header_particles(set: &crate::case_file::ParticleSet) -> usize {
     set.gid.len()
+}
+
+/// Rank 0 draws the pictures of a run folder.
+fn plot(world: &Comm, dir: &std::path::Path) -> Result<(), String> {
+    if world.rank() != 0 {
+        return Ok(());
+    }
+    let files = crate::plot::plot_run(dir).map_err(|e| e.to_string())?;
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
 }
 
 /// Collective. Meshes the case once and prints the rank-count independent fingerprint.

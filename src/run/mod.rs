@@ -49,5 +49,5 @@ pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), String>
         progress.step(&sim, &report, &t);
     }
     progress.finish(&sim);
-    Ok(())
+    out.plot(world)
 }

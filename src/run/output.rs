@@ -98,6 +98,21 @@ impl Output {
         self.fields.write(world, &frame).map_err(|e| e.to_string())
     }
 
+    /// Collective. Rank 0 draws the run's pictures (`pfem-mpi plot DIR` redraws them).
+    pub fn plot(&self, world: &Comm) -> Result<(), String> {
+        let local = if world.rank() == 0 {
+            crate::plot::plot_run(&self.dir)
+                .err()
+                .map(|e| e.to_string())
+        } else {
+            None
+        };
+        match pfem_partition::agree_on_error(world, local) {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
     /// Collective. Appends the step's row.
     pub fn record(&mut self, world: &Comm, sim: &Simulation) -> Result<(), String> {
         let m = sim.measures(world);
