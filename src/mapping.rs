@@ -73,19 +73,17 @@ pub struct MapStats {
     pub interpolated: usize,
 }
 
-/// States for `mesh`'s triangles. A triangle that existed before keeps its states. A new one
-/// takes, at each Gauss point, the linear Gauss field of the old triangle that contains the point
-/// (Gauss point -> old element field -> new Gauss point, with no averaging between elements, so a
-/// diagonal flip inside a quad moves no information across the quad); where no old triangle
-/// covers the point (refined or boundary regions) it interpolates the particle values
-/// `at_points` (indexed like `mesh.points`).
+/// States for `mesh`'s triangles: kept where the triangle existed before (same three global
+/// ids), otherwise interpolated linearly from the particle values `at_points` (indexed like
+/// `mesh.points`). Both inputs are bitwise identical on every rank that holds the triangle (the
+/// particle values travel with the halo), so every copy of an interface triangle gets the same
+/// states. (Interpolating from the old triangle that contains a new Gauss point would smooth less,
+/// but a rank does not hold every old triangle around its ghost triangles, so copies could differ.)
 pub fn map_states(
     old: &TriStates,
     mesh: &LocalMesh,
     at_points: &[[f64; K]],
 ) -> (Vec<[GaussState; 3]>, MapStats) {
-    let index = mesh.index_of();
-    let old_fields = OldFields::new(old, &index);
     let mut stats = MapStats::default();
     let states = (0..mesh.tris.len())
         .map(|t| {
@@ -98,58 +96,11 @@ pub fn map_states(
             let v = tri.map(|i| mesh.points[i as usize]);
             let vals = tri.map(|i| at_points[i as usize]);
             p2_gauss_points(&straight_sided(&v)).map(|p| {
-                let value = old_fields
-                    .at(&tri, p, mesh)
-                    .unwrap_or_else(|| interpolate_linear(barycentric(v[0], v[1], v[2], p), &vals));
-                GaussState::from_array(&value)
+                GaussState::from_array(&interpolate_linear(barycentric(v[0], v[1], v[2], p), &vals))
             })
         })
         .collect();
     (states, stats)
-}
-
-/// The old mesh's triangles on the current particle positions, with their Gauss fields
-/// extrapolated to the vertices, found through the particles they touch.
-struct OldFields {
-    tris: Vec<([u32; 3], [[f64; K]; 3])>,
-    around: std::collections::HashMap<u32, Vec<usize>>,
-}
-
-impl OldFields {
-    fn new(old: &TriStates, index: &std::collections::HashMap<u64, u32>) -> OldFields {
-        let mut tris = Vec::new();
-        let mut around: std::collections::HashMap<u32, Vec<usize>> =
-            std::collections::HashMap::new();
-        for (key, states) in old.iter() {
-            let (Some(&a), Some(&b), Some(&c)) =
-                (index.get(&key[0]), index.get(&key[1]), index.get(&key[2]))
-            else {
-                continue;
-            };
-            for v in [a, b, c] {
-                around.entry(v).or_default().push(tris.len());
-            }
-            tris.push((
-                [a, b, c],
-                extrapolate_to_vertices(&states.map(|g| g.to_array())),
-            ));
-        }
-        OldFields { tris, around }
-    }
-
-    fn at(&self, new_tri: &[u32; 3], p: [f64; 2], mesh: &LocalMesh) -> Option<[f64; K]> {
-        for v in new_tri {
-            for &o in self.around.get(v).map(Vec::as_slice).unwrap_or(&[]) {
-                let (t, vals) = &self.tris[o];
-                let [a, b, c] = t.map(|i| mesh.points[i as usize]);
-                let l = barycentric(a, b, c, p);
-                if l.iter().all(|x| x.is_finite() && *x >= -1e-12) {
-                    return Some(interpolate_linear(l, vals));
-                }
-            }
-        }
-        None
-    }
 }
 
 /// Particle values of the Gauss states: each triangle's linear extrapolation to its vertices,
