@@ -2,6 +2,10 @@
 //! initialised only once per process, so multi-rank tests launch processes).
 #![allow(dead_code)]
 
+mod launch;
+#[allow(unused_imports)]
+pub use launch::{example_binary, run_captured};
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::atomic::{AtomicUsize, Ordering};
