@@ -29,6 +29,7 @@ pub struct Progress {
     every: u64,
     total: u64,
     started: Instant,
+    newton: usize,
 }
 
 impl Progress {
@@ -39,10 +40,12 @@ impl Progress {
             every: if tty { 1 } else { (total / 20).max(1) },
             total,
             started: Instant::now(),
+            newton: 0,
         }
     }
 
     pub fn step(&mut self, sim: &Simulation, r: &StepReport, t: &PhaseTimer) {
+        self.newton += r.newton_iterations;
         let step = sim.step();
         if !self.root || (!step.is_multiple_of(self.every) && step != self.total) {
             return;
@@ -72,9 +75,10 @@ impl Progress {
     pub fn finish(&self, sim: &Simulation) {
         if self.root {
             println!(
-                "done: step {} in {:.2} s",
+                "done: step {} in {:.2} s, {} Newton iterations",
                 sim.step(),
-                self.started.elapsed().as_secs_f64()
+                self.started.elapsed().as_secs_f64(),
+                self.newton
             );
         }
     }
