@@ -16,15 +16,17 @@ for element in p2 p2p1; do
   for h in 0.5 0.25 0.125; do
     name="${element}_$h"
     "$bin" new footing-shallow -o "$name.h5" --set mesh.h=$h --set material.young=1e7 \
-      --set 'prescribed[0].total=[0.0,-0.01]' --set steps.count=20 --set solver.element=$element >/dev/null
+      --set 'prescribed[0].total=[0.0,-0.01]' --set steps.count=20 --set solver.element=$element \
+      --set solver.newton_max_it=60 >/dev/null
     t0=$(date +%s.%N)
     if mpirun -n "$ranks" "$bin" "$name.h5" >"$name.log" 2>&1; then
       t1=$(date +%s.%N)
       q=$(tail -1 "$name.out/history.csv" | cut -d, -f3)
       n=$("$bin" info "$name.h5" | awk '/^particles/ {print $2}')
-      printf '| %s | %s | %s | %.4f | %+.2f %% | %.1f |\n' "$element" "$h" "$n" "$q" "$(echo "100*($q/5.14159265-1)" | bc -l)" "$(echo "$t1 - $t0" | bc)"
+      err=$(awk -v q="$q" 'BEGIN { printf "%+.2f", 100 * (q / (2 + atan2(0, -1)) - 1) }')
+      printf '| %s | %s | %s | %.4f | %s %% | %.1f |\n' "$element" "$h" "$n" "$q" "$err" "$(echo "$t1 - $t0" | bc)"
     else
-      printf '| %s | %s | | failed: %s | | |\n' "$element" "$h" "$(tail -1 "$name.log" | cut -c1-60)"
+      printf '| %s | %s | | failed: %s | | |\n' "$element" "$h" "$(grep -m1 -o 'step [0-9]*: Newton did not converge ([A-Z_]*)' "$name.log")"
     fi
   done
 done

@@ -22,7 +22,7 @@ while IFS='|' read -r label opts; do
       v=$(tail -1 "$out/history.csv" | cut -d, -f4)
       printf '| %s | %s | %.1f | %s | %.6f |\n' "$label" "$ranks" "$(echo "$t1 - $t0" | bc)" "$its" "$v"
     else
-      printf '| %s | %s | failed: %s | | |\n' "$label" "$ranks" "$(tail -1 "$out.log" | cut -c1-60)"
+      printf '| %s | %s | failed: %s | | |\n' "$label" "$ranks" "$(grep -m1 -o 'Newton did not converge ([A-Z_]*)' "$out.log")"
     fi
   done
 done <<'LIST'
