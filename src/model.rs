@@ -75,8 +75,9 @@ impl Model {
         step as f64 / self.scene.steps.count as f64
     }
 
-    /// Prescribed displacement increment of a step for a particle at reference position `x`.
-    pub fn step_bc(&self, x: [f64; 2]) -> [Option<f64>; 2] {
+    /// Prescribed displacement increment for a load-factor increment `dlambda` (1/steps for a
+    /// whole step) for a particle at reference position `x`.
+    pub fn step_bc(&self, x: [f64; 2], dlambda: f64) -> [Option<f64>; 2] {
         let mut bc = [None, None];
         for f in &self.scene.fixed {
             if f.region.matches(x, self.tol) {
@@ -85,11 +86,10 @@ impl Model {
                 }
             }
         }
-        let n = self.scene.steps.count as f64;
         for p in &self.scene.prescribed {
             if p.region.matches(x, self.tol) {
                 for d in &p.dofs {
-                    bc[d.index()] = Some(p.total[d.index()] / n);
+                    bc[d.index()] = Some(p.total[d.index()] * dlambda);
                 }
             }
         }

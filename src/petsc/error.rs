@@ -17,6 +17,13 @@ impl fmt::Display for PetscError {
 
 impl std::error::Error for PetscError {}
 
+impl PetscError {
+    /// Newton ran but did not converge, as opposed to a failing call.
+    pub fn is_divergence(&self) -> bool {
+        self.code == super::snes::DIVERGED
+    }
+}
+
 /// Turns a PETSc error code into a `Result`, with PETSc's own text for the code.
 pub fn check(code: ffi::PetscErrorCode, call: &str) -> Result<(), PetscError> {
     if code == 0 {

@@ -45,6 +45,8 @@ struct Ctx<'a> {
 }
 
 const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
+/// Not a PETSc code: SNES ran but did not converge (a smaller step may).
+pub const DIVERGED: ffi::PetscErrorCode = -1001;
 
 impl Snes {
     /// Collective. Newton with full steps and a direct LU solve by MUMPS by default: robust for the
@@ -166,7 +168,7 @@ impl Snes {
                     CStr::from_ptr(text).to_string_lossy().into_owned()
                 };
                 return Err(PetscError {
-                    code: PETSC_ERR_USER,
+                    code: DIVERGED,
                     message: format!("Newton did not converge ({why}) after {its} iterations, residual {norm:.3e}"),
                 });
             }

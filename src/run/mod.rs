@@ -33,10 +33,9 @@ pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), String>
     let mut last = opts.until_step.unwrap_or(u64::MAX).min(sim.total_steps());
     while sim.step() < last {
         let mut t = PhaseTimer::default();
-        let mesh = t.time("remesh", || sim.remesh(world))?;
+        let mut mesh = t.time("remesh", || sim.remesh(world))?;
         let states = t.time("map", || sim.map(&mesh));
-        let solved = t.time("solve", || sim.solve(world, petsc, &mesh, &states))?;
-        let report = t.time("update", || sim.update(world, &mesh, solved))?;
+        let report = t.time("solve", || sim.advance(world, petsc, &mut mesh, states))?;
         if stop.requested(world) {
             last = sim.step();
         }

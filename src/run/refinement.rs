@@ -29,7 +29,7 @@ impl Simulation {
                 || mesh.on_boundary[p]
                 || self
                     .model
-                    .step_bc(self.particles.reference_position(p))
+                    .step_bc(self.particles.reference_position(p), 1.0)
                     .iter()
                     .any(Option::is_some)
         };

@@ -31,6 +31,8 @@ pub struct Simulation {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct StepReport {
     pub newton_iterations: usize,
+    /// Times the step's increment was halved after a Newton divergence.
+    pub cuts: usize,
     pub residual_norm: f64,
     pub particles: u64,
     pub triangles: u64,

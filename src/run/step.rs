@@ -9,18 +9,32 @@ use crate::petsc::{Mat, PVec, Petsc, Snes};
 use crate::solve::{Constraints, DofMap, StepProblem, StepSetup};
 use pfem_partition::{sum_f64, Comm};
 
+/// Why a solve failed.
+#[derive(Debug)]
+pub enum SolveError {
+    /// Newton did not converge: a smaller increment may.
+    Diverged(String),
+    Fatal(String),
+}
+
+impl std::fmt::Display for SolveError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SolveError::Diverged(m) | SolveError::Fatal(m) => f.write_str(m),
+        }
+    }
+}
+
 /// The solved step, before particles move.
 pub struct Solved {
+    /// Load-factor increment solved for.
+    dlambda: f64,
     dofs: DofMap,
     du: Vec<[f64; 2]>,
     states: Vec<[GaussState; 3]>,
     reaction: [f64; 2],
     newton_iterations: usize,
     residual_norm: f64,
-}
-
-fn err<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
 }
 
 /// Pressure (compression positive) of a particle state.
@@ -37,21 +51,30 @@ impl Simulation {
         }
     }
 
-    /// Collective. One implicit updated-Lagrangian increment by Newton (PETSc SNES).
+    /// Collective. One implicit updated-Lagrangian increment by Newton (PETSc SNES) from load
+    /// factor `from` to `to`. A Newton divergence is returned as `Err(Diverged)`: a smaller
+    /// increment may converge.
     pub fn solve(
         &self,
         world: &Comm,
         petsc: &Petsc,
         mesh: &LocalMesh,
         states_n: &[[GaussState; 3]],
-    ) -> Result<Solved, String> {
+        from: f64,
+        to: f64,
+    ) -> Result<Solved, SolveError> {
         let _ = petsc;
+        let err = |e: String| SolveError::Fatal(e);
         let step = self.header.step + 1;
-        let dofs = DofMap::build(world, mesh, self.model.mixed()).map_err(err)?;
+        let dofs =
+            DofMap::build(world, mesh, self.model.mixed()).map_err(|e| err(e.to_string()))?;
         let constraints = Constraints::build(&dofs, |p| {
-            self.model.step_bc(self.reference_position(mesh, p))
+            self.model
+                .step_bc(self.reference_position(mesh, p), to - from)
         });
-        let factor = self.model.load_factor(step);
+        // The last increment scaled to this one is the predictor.
+        let scale = (to - from) * self.model.scene.steps.count as f64;
+        let factor = to;
         let mut point_loads = Vec::new();
         for (load, &gid) in self
             .model
@@ -75,10 +98,12 @@ impl Simulation {
             constraints: &constraints,
             point_loads,
         };
-        let x = PVec::mpi(world, dofs.n_owned_dofs).map_err(err)?;
+        let x = PVec::mpi(world, dofs.n_owned_dofs).map_err(|e| err(e.to_string()))?;
         let (d_nnz, o_nnz) = dofs.preallocation();
-        let jac = Mat::aij(world, dofs.n_owned_dofs, &d_nnz, &o_nnz).map_err(err)?;
-        let mut problem = StepProblem::new(world, mesh, &dofs, setup, &x).map_err(err)?;
+        let jac =
+            Mat::aij(world, dofs.n_owned_dofs, &d_nnz, &o_nnz).map_err(|e| err(e.to_string()))?;
+        let mut problem =
+            StepProblem::new(world, mesh, &dofs, setup, &x).map_err(|e| err(e.to_string()))?;
         // Predictor: the last step's increment (a proportional step's best guess, which also keeps
         // Newton off the zero-energy shear-band modes of a plastic limit state) and the current
         // pressure.
@@ -90,14 +115,18 @@ impl Simulation {
                 let p = dofs.node_point[n];
                 if p != u32::MAX {
                     let (d, s) = (inc(p as usize), state(p as usize));
-                    [d[0], d[1], pressure(&s)]
+                    [scale * d[0], scale * d[1], pressure(&s)]
                 } else {
                     let [a, b] = dofs.edges[n - (dofs.n_nodes() - dofs.edges.len())];
                     let (da, db) = (inc(a as usize), inc(b as usize));
-                    [0.5 * (da[0] + db[0]), 0.5 * (da[1] + db[1]), 0.0]
+                    [
+                        0.5 * scale * (da[0] + db[0]),
+                        0.5 * scale * (da[1] + db[1]),
+                        0.0,
+                    ]
                 }
             })
-            .map_err(err)?;
+            .map_err(|e| err(e.to_string()))?;
         let solver = &self.model.scene.solver;
         let line_search = if self.model.plastic() { "bt" } else { "basic" };
         let mut snes = Snes::new(
@@ -106,14 +135,21 @@ impl Simulation {
             solver.newton_max_it as usize,
             line_search,
         )
-        .map_err(err)?;
-        let stats = snes
-            .solve(&mut problem, &x, &jac)
-            .map_err(|e| format!("step {step}: {}", e.message))?;
-        let local = problem.local_values(x.as_ref()).map_err(err)?;
+        .map_err(|e| err(e.to_string()))?;
+        let stats = snes.solve(&mut problem, &x, &jac).map_err(|e| {
+            let msg = format!("step {step}: {}", e.message);
+            if e.is_divergence() {
+                SolveError::Diverged(msg)
+            } else {
+                SolveError::Fatal(msg)
+            }
+        })?;
+        let local = problem
+            .local_values(x.as_ref())
+            .map_err(|e| err(e.to_string()))?;
         let elems = problem
             .elements(&local)
-            .map_err(|e| format!("step {step}: {e}"))?;
+            .map_err(|e| SolveError::Fatal(format!("step {step}: {e}")))?;
         let n_vertex = dofs.n_nodes() - dofs.edges.len();
         let driven = |n: usize| {
             let pts: Vec<u32> = if n < n_vertex {
@@ -130,6 +166,7 @@ impl Simulation {
         let du = problem.node_displacements(&local);
         drop(problem);
         Ok(Solved {
+            dlambda: to - from,
             dofs,
             du,
             states: elems.into_iter().map(|e| e.states).collect(),
@@ -140,12 +177,16 @@ impl Simulation {
     }
 
     /// Collective. Moves the particles and carries the new Gauss states to them.
+    /// `completes`: the increment ends the step (otherwise it is a piece of a cut step).
     pub fn update(
         &mut self,
         world: &Comm,
         mesh: &LocalMesh,
         solved: Solved,
+        completes: bool,
     ) -> Result<StepReport, String> {
+        // Increments are kept per whole step: the predictor of the next increment scales them.
+        let per_step = 1.0 / (solved.dlambda * self.model.scene.steps.count as f64);
         for i in 0..self.particles.len() {
             let node = solved.dofs.node_of_point[i];
             let d = if node != u32::MAX {
@@ -157,24 +198,80 @@ impl Simulation {
                 self.particles.position[i][c] += dc;
                 self.particles.displacement[i][c] += dc;
             }
-            self.particles.increment[i] = d;
+            self.particles.increment[i] = [per_step * d[0], per_step * d[1]];
         }
         self.particles.state = recover_at_particles(mesh, &solved.states, &self.particles.state);
         self.tri_states = TriStates::new(mesh, solved.states);
         self.last_reaction = solved.reaction;
         self.last_area = owned_area(mesh, &solved.du, &solved.dofs);
-        self.header.step += 1;
-        self.header.load_factor = self.model.load_factor(self.header.step);
+        if completes {
+            self.header.step += 1;
+            self.header.load_factor = self.model.load_factor(self.header.step);
+        } else {
+            self.header.load_factor += solved.dlambda;
+        }
         let counts = sum_f64(
             world,
             &[self.particles.len() as f64, mesh.n_owned_tris() as f64],
         );
         Ok(StepReport {
             newton_iterations: solved.newton_iterations,
+            cuts: 0,
             residual_norm: solved.residual_norm,
             particles: counts[0] as u64,
             triangles: counts[1] as u64,
         })
+    }
+}
+
+/// Halvings of a step's increment before a Newton failure is final.
+const MAX_CUTS: usize = 6;
+
+impl Simulation {
+    /// Collective. Solves the next step on `mesh` and moves the particles. When Newton diverges,
+    /// the rest of the step is cut in half (up to 6 times, growing back after each success), each
+    /// piece a full remesh–map–solve–update cycle; `mesh` ends as the mesh of the last piece.
+    pub fn advance(
+        &mut self,
+        world: &Comm,
+        petsc: &Petsc,
+        mesh: &mut LocalMesh,
+        states: Vec<[GaussState; 3]>,
+    ) -> Result<StepReport, String> {
+        let full = 1.0 / self.model.scene.steps.count as f64;
+        let target = self.model.load_factor(self.header.step + 1);
+        let mut from = self.header.load_factor;
+        let mut piece = full;
+        let mut states = states;
+        let (mut cuts, mut newton) = (0, 0);
+        loop {
+            let to = if from + piece >= target - 1e-9 * full {
+                target
+            } else {
+                from + piece
+            };
+            match self.solve(world, petsc, mesh, &states, from, to) {
+                Ok(solved) => {
+                    let completes = to == target;
+                    let mut report = self.update(world, mesh, solved, completes)?;
+                    newton += report.newton_iterations;
+                    if completes {
+                        report.newton_iterations = newton;
+                        report.cuts = cuts;
+                        return Ok(report);
+                    }
+                    from = to;
+                    piece = (2.0 * piece).min(full);
+                    *mesh = self.remesh(world)?;
+                    states = self.map(mesh);
+                }
+                Err(SolveError::Diverged(_)) if cuts < MAX_CUTS => {
+                    cuts += 1;
+                    piece *= 0.5;
+                }
+                Err(e) => return Err(e.to_string()),
+            }
+        }
     }
 }
 
