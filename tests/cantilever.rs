@@ -56,3 +56,37 @@ fn default_mesh_is_within_one_percent_and_ranks_agree() {
         assert!(worst < 1e-3, "{ranks} ranks differ from 1 rank by {worst}");
     }
 }
+
+/// A step whose Newton iteration cannot converge within the allowed iterations is cut into smaller
+/// increments, and the analysis ends where the uncut one does.
+#[test]
+fn diverging_steps_are_cut_and_recovered() {
+    let dir = workdir("cantilever-cuts");
+    ok(
+        &dir,
+        1,
+        &[
+            "new",
+            "cantilever",
+            "-o",
+            "c.h5",
+            "--set",
+            "mesh.h=0.25",
+            "--set",
+            "steps.count=10",
+        ],
+    );
+    ok(&dir, 1, &["c.h5", "--out", "plain"]);
+    let log = ok(
+        &dir,
+        2,
+        &["c.h5", "--out", "cut", "--", "-snes_max_it", "4"],
+    );
+    assert!(log.contains("(cut "), "steps should have been cut:\n{log}");
+    let (_, plain) = history(&dir.join("plain/history.csv"));
+    let (_, cut) = history(&dir.join("cut/history.csv"));
+    assert_eq!(cut.len(), 10);
+    let rel = ((cut[9][3] - plain[9][3]) / plain[9][3]).abs();
+    println!("cut run differs from the plain run by {rel:.2e} in v/L at lambda = 10");
+    assert!(rel < 1e-3, "{rel}");
+}
