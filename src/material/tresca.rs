@@ -43,6 +43,7 @@
 //! 10 cu. With [`crate::fem::mixed::p2p1_element`] it is (logarithmic strain, rotation-free
 //! Cauchy stress), and the end-of-step Cauchy stress is on the yield surface to round-off.
 
+use super::elastic::LinearElastic;
 use super::{GaussState, Material, MaterialError, MaterialResponse};
 
 /// Elastic–perfectly plastic undrained clay (plane-strain Tresca); see the module docs.
@@ -80,22 +81,9 @@ const P_IN: [[f64; 4]; 4] = [
 impl Tresca {
     /// Validates `young > 0`, `-1 < poisson < 0.5` and `cu > 0` (all finite).
     pub fn new(young: f64, poisson: f64, cu: f64) -> Result<Self, MaterialError> {
-        if !(young.is_finite() && young > 0.0) {
-            return Err(MaterialError::InvalidParameter {
-                name: "young",
-                value: young,
-                requirement: "0 < young < inf",
-            });
-        }
-        // K is infinite at ν = 0.5; exact incompressibility is the mixed element's job (its
-        // `bulk` argument may be infinite), not the material's.
-        if !(poisson.is_finite() && poisson > -1.0 && poisson < 0.5) {
-            return Err(MaterialError::InvalidParameter {
-                name: "poisson",
-                value: poisson,
-                requirement: "-1 < poisson < 0.5",
-            });
-        }
+        // The elastic part has the linear-elastic bounds; K is infinite at ν = 0.5, and exact
+        // incompressibility is the mixed element's job (its `bulk` may be infinite).
+        LinearElastic::new(young, poisson)?;
         if !(cu.is_finite() && cu > 0.0) {
             return Err(MaterialError::InvalidParameter {
                 name: "cu",
