@@ -25,6 +25,8 @@ pub struct Simulation {
     /// This rank's share of the last step's footing/platen reaction and body area.
     pub(super) last_reaction: [f64; 2],
     pub(super) last_area: f64,
+    /// PETSc objects of the last increment (kept while the matrix pattern stays the same).
+    pub(super) solver: std::cell::RefCell<Option<super::step::SolverObjects>>,
     first_step: u64,
 }
 
@@ -74,6 +76,7 @@ impl Simulation {
             tri_states: TriStates::default(),
             last_reaction: [0.0; 2],
             last_area: 0.0,
+            solver: Default::default(),
         };
         if world.size() > 1 && !same_partition {
             sim.repartition(world)?;

@@ -9,6 +9,33 @@ use crate::petsc::{Mat, PVec, Petsc, Snes};
 use crate::solve::{Constraints, DofMap, StepProblem, StepSetup};
 use pfem_partition::{sum_f64, Comm};
 
+/// PETSc objects reused across increments with the same matrix pattern.
+pub struct SolverObjects {
+    signature: u64,
+    x: PVec,
+    jac: Mat,
+    snes: Snes,
+}
+
+/// FNV-1a over the global dof numbers of every local triangle: equal signatures mean the same
+/// matrix pattern on this rank.
+fn pattern_signature(dofs: &DofMap) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |v: u64| {
+        h ^= v;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    };
+    eat(dofs.n_owned_dofs as u64);
+    eat(dofs.first_dof as u64);
+    eat(dofs.vertex_dofs as u64);
+    for nodes in &dofs.tri_nodes {
+        for &n in nodes {
+            eat(dofs.node_global[n as usize] as u64);
+        }
+    }
+    h
+}
+
 /// Why a solve failed.
 #[derive(Debug)]
 pub enum SolveError {
@@ -98,12 +125,82 @@ impl Simulation {
             constraints: &constraints,
             point_loads,
         };
-        let x = PVec::mpi(world, dofs.n_owned_dofs).map_err(|e| err(e.to_string()))?;
+        let mut cache = self
+            .solver_objects(world, &dofs)
+            .map_err(|e| err(e.to_string()))?;
+        let outcome = self.solve_with(world, mesh, &dofs, setup, &mut cache, scale, step);
+        // Kept for the next increment on the same pattern (a cut piece, or an unchanged mesh).
+        *self.solver.borrow_mut() = Some(cache);
+        outcome.map(|(du, states, reaction, stats)| Solved {
+            dlambda: to - from,
+            dofs,
+            du,
+            states,
+            reaction,
+            newton_iterations: stats.newton_iterations,
+            residual_norm: stats.residual_norm,
+        })
+    }
+
+    /// Collective. The vector, matrix and SNES for `dofs`: last increment's when the matrix
+    /// pattern is the same on every rank (PETSc then keeps the symbolic factorisation), new ones
+    /// otherwise.
+    fn solver_objects(
+        &self,
+        world: &Comm,
+        dofs: &DofMap,
+    ) -> Result<SolverObjects, crate::petsc::PetscError> {
+        let signature = pattern_signature(dofs);
+        let cached = self.solver.borrow_mut().take();
+        let same = cached.as_ref().is_some_and(|c| c.signature == signature);
+        if sum_f64(world, &[if same { 0.0 } else { 1.0 }])[0] == 0.0 {
+            if let Some(c) = cached {
+                return Ok(c);
+            }
+        }
+        drop(cached);
+        let x = PVec::mpi(world, dofs.n_owned_dofs)?;
         let (d_nnz, o_nnz) = dofs.preallocation();
-        let jac =
-            Mat::aij(world, dofs.n_owned_dofs, &d_nnz, &o_nnz).map_err(|e| err(e.to_string()))?;
+        let jac = Mat::aij(world, dofs.n_owned_dofs, &d_nnz, &o_nnz)?;
+        let solver = &self.model.scene.solver;
+        let line_search = if self.model.plastic() { "bt" } else { "basic" };
+        let snes = Snes::new(
+            world,
+            solver.newton_rtol,
+            solver.newton_max_it as usize,
+            line_search,
+        )?;
+        Ok(SolverObjects {
+            signature,
+            x,
+            jac,
+            snes,
+        })
+    }
+
+    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    fn solve_with(
+        &self,
+        world: &Comm,
+        mesh: &LocalMesh,
+        dofs: &DofMap,
+        setup: StepSetup,
+        objects: &mut SolverObjects,
+        scale: f64,
+        step: u64,
+    ) -> Result<
+        (
+            Vec<[f64; 2]>,
+            Vec<[GaussState; 3]>,
+            [f64; 2],
+            crate::petsc::SolveStats,
+        ),
+        SolveError,
+    > {
+        let err = |e: String| SolveError::Fatal(e);
+        let SolverObjects { x, jac, snes, .. } = objects;
         let mut problem =
-            StepProblem::new(world, mesh, &dofs, setup, &x).map_err(|e| err(e.to_string()))?;
+            StepProblem::new(world, mesh, dofs, setup, x).map_err(|e| err(e.to_string()))?;
         // Predictor: the last step's increment (a proportional step's best guess, which also keeps
         // Newton off the zero-energy shear-band modes of a plastic limit state) and the current
         // pressure.
@@ -111,7 +208,7 @@ impl Simulation {
             |p: usize| self.point_value(mesh, p, &self.particles.increment, &self.ghosts.increment);
         let state = |p: usize| self.point_value(mesh, p, &self.particles.state, &self.ghosts.state);
         problem
-            .initial_guess(&x, |n| {
+            .initial_guess(x, |n| {
                 let p = dofs.node_point[n];
                 if p != u32::MAX {
                     let (d, s) = (inc(p as usize), state(p as usize));
@@ -127,16 +224,7 @@ impl Simulation {
                 }
             })
             .map_err(|e| err(e.to_string()))?;
-        let solver = &self.model.scene.solver;
-        let line_search = if self.model.plastic() { "bt" } else { "basic" };
-        let mut snes = Snes::new(
-            world,
-            solver.newton_rtol,
-            solver.newton_max_it as usize,
-            line_search,
-        )
-        .map_err(|e| err(e.to_string()))?;
-        let stats = snes.solve(&mut problem, &x, &jac).map_err(|e| {
+        let stats = snes.solve(&mut problem, x, jac).map_err(|e| {
             let msg = format!("step {step}: {}", e.message);
             if e.is_divergence() {
                 SolveError::Diverged(msg)
@@ -164,16 +252,12 @@ impl Simulation {
         };
         let reaction = problem.reaction(&elems, driven);
         let du = problem.node_displacements(&local);
-        drop(problem);
-        Ok(Solved {
-            dlambda: to - from,
-            dofs,
+        Ok((
             du,
-            states: elems.into_iter().map(|e| e.states).collect(),
+            elems.into_iter().map(|e| e.states).collect(),
             reaction,
-            newton_iterations: stats.newton_iterations,
-            residual_norm: stats.residual_norm,
-        })
+            stats,
+        ))
     }
 
     /// Collective. Moves the particles and carries the new Gauss states to them.
