@@ -45,6 +45,11 @@ struct Ctx<'a> {
 }
 
 const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
+/// Newton also stops when its update is this small relative to the solution: with a good
+/// predictor the first residual is already small, and a residual tolerance relative to it alone
+/// can lie below round-off.
+const STEP_TOL: f64 = 1e-10;
+
 /// Not a PETSc code: SNES ran but did not converge (a smaller step may).
 pub const DIVERGED: ffi::PetscErrorCode = -1001;
 
@@ -67,7 +72,7 @@ impl Snes {
             check(ffi::SNESCreate(comm.as_raw(), &mut raw), "SNESCreate")?;
             let snes = Snes { raw };
             check(
-                ffi::SNESSetTolerances(raw, 1e-50, rtol, 0.0, max_it as ffi::PetscInt, 10_000),
+                ffi::SNESSetTolerances(raw, 1e-50, rtol, STEP_TOL, max_it as ffi::PetscInt, 10_000),
                 "SNESSetTolerances",
             )?;
             let mut ksp: ffi::KSP = std::ptr::null_mut();
