@@ -88,3 +88,30 @@ fn deformed_cloud_mesh_is_rank_count_independent() {
         "the bent beam must mesh differently from the straight one"
     );
 }
+
+/// A graded cloud (`mesh.fine` regions around the footing edge) meshes without holes (Euler:
+/// triangles = 2 n − 2 − boundary vertices, one boundary loop) and identically on 1, 2, 3 ranks.
+#[test]
+fn graded_cloud_meshes_without_holes_on_any_rank_count() {
+    let dir = workdir("fp-graded");
+    let fine = "mesh.fine=[{origin=[0.0,8.5],size=[2.5,1.5],h=0.125},{origin=[0.5,9.5],size=[1.0,0.5],h=0.0625}]";
+    ok(
+        &dir,
+        1,
+        &["new", "footing-shallow", "-o", "g.h5", "--set", fine],
+    );
+    let lines = fingerprints(&dir, "g.h5");
+    assert_same("graded cloud", &lines);
+    let (n, t, b) = (
+        count(&lines[0], "particles"),
+        count(&lines[0], "triangles"),
+        count(&lines[0], "boundary_edges"),
+    );
+    assert!(n > 41 * 41, "fine regions add particles: {n}");
+    assert_eq!(
+        t,
+        2 * n - 2 - b,
+        "a hole or a missing triangle: {}",
+        lines[0]
+    );
+}

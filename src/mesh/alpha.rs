@@ -34,10 +34,11 @@ pub fn circumradius(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
 
 /// Alpha-shape decision for each triangle of `tris` (local indices into `points` and `h`).
 ///
-/// Triangle `T` is kept iff `circumradius(T) <= alpha * h_T`, where `h_T` is the mean of the
-/// spacings `h` of its three vertices. The decision depends only on the triangle's own three
-/// points and spacings, not on their order: the three `h` values are summed in increasing
-/// order and [`circumradius`] is order-independent.
+/// Triangle `T` is kept iff `circumradius(T) <= alpha * h_T`, where `h_T` is the largest of the
+/// spacings `h` of its three vertices: in a graded cloud the triangles between a fine and a
+/// coarse lattice are as large as the coarse ones and must survive. The decision depends only on
+/// the triangle's own three points and spacings, not on their order ([`circumradius`] is
+/// order-independent).
 ///
 /// A triangle with an index outside `points` or `h`, a non-finite spacing, or zero area is not
 /// kept.
@@ -61,9 +62,8 @@ fn keep_triangle(points: &[[f64; 2]], h: &[f64], t: [u32; 3], alpha: f64) -> boo
         }
     }
     hs.sort_unstable_by(f64::total_cmp);
-    let h_mean = (hs[0] + hs[1] + hs[2]) / 3.0;
     // A NaN on either side makes the comparison false, i.e. the triangle is dropped.
-    circumradius(p[0], p[1], p[2]) <= alpha * h_mean
+    circumradius(p[0], p[1], p[2]) <= alpha * hs[2]
 }
 
 /// Edges that belong to exactly one triangle of `tris` (typically the kept triangles).
@@ -325,13 +325,13 @@ mod tests {
     }
 
     #[test]
-    fn variable_spacing_uses_the_vertex_mean() {
+    fn variable_spacing_uses_the_largest_vertex_spacing() {
         // Right triangle with legs 2: R = sqrt(2).
         let pts = [[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]];
         let tri = [[0, 1, 2]];
         let r = 2f64.sqrt();
-        // Mean spacing 1: kept iff alpha >= sqrt(2).
-        let h = [0.5, 1.0, 1.5];
+        // Largest spacing 1: kept iff alpha >= sqrt(2).
+        let h = [0.5, 1.0, 0.25];
         assert_eq!(alpha_keep(&pts, &tri, &h, r * 1.000_001), vec![true]);
         assert_eq!(alpha_keep(&pts, &tri, &h, r * 0.999_999), vec![false]);
     }

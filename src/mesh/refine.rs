@@ -73,7 +73,8 @@ pub fn plan(mesh: &LocalMesh, protected: impl Fn(usize) -> bool, params: &Refine
         let (p, q) = (mesh.points[a as usize], mesh.points[b as usize]);
         ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
     };
-    let spacing = |a: u32, b: u32| 0.5 * (h[a as usize] + h[b as usize]);
+    // The coarser end's spacing: edges between a fine and a coarse lattice are not "too long".
+    let spacing = |a: u32, b: u32| h[a as usize].max(h[b as usize]);
     let split: Vec<[u32; 2]> = edges
         .iter()
         .filter(|&&(_, _, a, b)| dist(a, b) > params.split_length * spacing(a, b))

@@ -16,7 +16,7 @@ impl Simulation {
     /// Collective. Inserts, removes and smooths particles as the scene asks; returns whether
     /// anything changed anywhere (then the mesh must be rebuilt).
     pub(super) fn refine(&mut self, world: &Comm, mesh: &LocalMesh) -> Result<bool, String> {
-        let settings = self.model.scene.mesh;
+        let settings = &self.model.scene.mesh;
         if !settings.refine && !settings.smooth {
             return Ok(false);
         }

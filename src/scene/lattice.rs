@@ -95,6 +95,61 @@ pub fn generate_particles(scene: &Scene) -> ParticleSet {
             }
         }
     }
+    if scene.mesh.fine.is_empty() {
+        return set;
+    }
+    refine_regions(scene, set)
+}
+
+/// Replaces the lattice inside each `[[mesh.fine]]` region by that region's finer lattice:
+/// finest regions first, a point already placed (a shared edge) is not placed again, and a
+/// coarser point strictly inside a finer region is dropped. Ids are renumbered row-major.
+fn refine_regions(scene: &Scene, base: ParticleSet) -> ParticleSet {
+    let mut regions = scene.mesh.fine.clone();
+    regions.sort_by(|a, b| a.h.total_cmp(&b.h));
+    let h_min = regions[0].h;
+    let key = |p: [f64; 2]| {
+        (
+            (p[0] / h_min * 1e3).round() as i64,
+            (p[1] / h_min * 1e3).round() as i64,
+        )
+    };
+    let tol = 1e-9 * h_min;
+    let inside_open = |p: [f64; 2], r: &super::schema::FineRegion| {
+        (0..2).all(|c| p[c] > r.origin[c] + tol && p[c] < r.origin[c] + r.size[c] - tol)
+    };
+    let in_body = |p: [f64; 2]| {
+        scene.body.rectangles.iter().any(|r| {
+            (0..2).all(|c| p[c] >= r.origin[c] - tol && p[c] <= r.origin[c] + r.size[c] + tol)
+        })
+    };
+    let mut placed = std::collections::HashSet::new();
+    let mut points: Vec<([f64; 2], f64)> = Vec::new();
+    for (k, r) in regions.iter().enumerate() {
+        let n = [
+            (r.size[0] / r.h).round() as i64,
+            (r.size[1] / r.h).round() as i64,
+        ];
+        for j in 0..=n[1] {
+            for i in 0..=n[0] {
+                let p = [r.origin[0] + i as f64 * r.h, r.origin[1] + j as f64 * r.h];
+                let finer = regions[..k].iter().any(|f| inside_open(p, f));
+                if in_body(p) && !finer && placed.insert(key(p)) {
+                    points.push((p, r.h));
+                }
+            }
+        }
+    }
+    for (p, h) in base.position.iter().zip(&base.h) {
+        if !regions.iter().any(|r| inside_open(*p, r)) && placed.insert(key(*p)) {
+            points.push((*p, *h));
+        }
+    }
+    points.sort_by(|a, b| a.0[1].total_cmp(&b.0[1]).then(a.0[0].total_cmp(&b.0[0])));
+    let mut set = ParticleSet::with_capacity(points.len());
+    for (gid, (p, h)) in points.into_iter().enumerate() {
+        set.push_new(gid as u64, p, h);
+    }
     set
 }
 

@@ -61,8 +61,20 @@ pub struct Rectangle {
     pub size: [f64; 2],
 }
 
-/// `[mesh]`: particle spacing and remeshing controls.
+/// `[[mesh.fine]]`: a rectangle of the body filled with a finer particle lattice.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FineRegion {
+    /// Lower-left corner (m); origin and size are whole multiples of the next coarser spacing,
+    /// so the coarse particles on the region's edges are also fine-lattice particles.
+    pub origin: [f64; 2],
+    pub size: [f64; 2],
+    /// Particle spacing inside (m), a whole fraction of the next coarser spacing.
+    pub h: f64,
+}
+
+/// `[mesh]`: particle spacing and remeshing controls.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Mesh {
     /// Particle spacing (m), > 0.
@@ -83,6 +95,11 @@ pub struct Mesh {
     /// left unchanged. For studying the cost of mapping. Default false.
     #[serde(default)]
     pub remap_all: bool,
+    /// Nested finer lattices, e.g. around a footing edge: `fine = [{ origin = [0.5, 9.5],
+    /// size = [1.0, 0.5], h = 0.0625 }]`. Where regions overlap the finest spacing wins. Default
+    /// none.
+    #[serde(default)]
+    pub fine: Vec<FineRegion>,
 }
 
 fn default_alpha() -> f64 {

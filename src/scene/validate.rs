@@ -90,6 +90,25 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
 
     let mesh = root.join("mesh");
     positive(mesh.join("h"), s.mesh.h)?;
+    for (i, r) in s.mesh.fine.iter().enumerate() {
+        let at = mesh.join("fine").at(i);
+        positive(at.join("h"), r.h)?;
+        if r.h >= s.mesh.h {
+            return fail(
+                at.join("h"),
+                format!("must be smaller than mesh.h = {} (got {})", s.mesh.h, r.h),
+            );
+        }
+        if !(r.size[0] > 0.0
+            && r.size[1] > 0.0
+            && r.size.iter().chain(&r.origin).all(|x| x.is_finite()))
+        {
+            return fail(
+                at.join("size"),
+                format!("must be > 0 in both components (got {})", vec2(r.size)),
+            );
+        }
+    }
     positive(mesh.join("alpha"), s.mesh.alpha)?;
     if s.mesh.alpha < std::f64::consts::FRAC_1_SQRT_2 {
         return fail(
