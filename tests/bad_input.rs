@@ -80,20 +80,7 @@ fn bad_command_lines_explain_usage() {
 #[test]
 fn a_step_that_cannot_converge_stops_all_ranks_with_the_reason() {
     let dir = workdir("bad-newton");
-    ok(
-        &dir,
-        1,
-        &[
-            "new",
-            "cantilever",
-            "-o",
-            "c.h5",
-            "--set",
-            "mesh.h=0.25",
-            "--set",
-            "steps.count=2",
-        ],
-    );
+    small_cantilever(&dir, 2, &[]);
     let out = run(&dir, 2, &["c.h5", "--", "-snes_max_it", "1"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());

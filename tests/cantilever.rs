@@ -62,20 +62,7 @@ fn default_mesh_is_within_one_percent_and_ranks_agree() {
 #[test]
 fn diverging_steps_are_cut_and_recovered() {
     let dir = workdir("cantilever-cuts");
-    ok(
-        &dir,
-        1,
-        &[
-            "new",
-            "cantilever",
-            "-o",
-            "c.h5",
-            "--set",
-            "mesh.h=0.25",
-            "--set",
-            "steps.count=10",
-        ],
-    );
+    small_cantilever(&dir, 10, &[]);
     ok(&dir, 1, &["c.h5", "--out", "plain"]);
     let log = ok(
         &dir,

@@ -72,23 +72,6 @@ fn call(dir: &Path, name: &str, args: &[&str], envs: &[(&str, &str)]) -> (i32, S
     finish(name, out)
 }
 
-fn small_cantilever(dir: &Path) {
-    ok(
-        dir,
-        1,
-        &[
-            "new",
-            "cantilever",
-            "-o",
-            "c.h5",
-            "--set",
-            "mesh.h=0.25",
-            "--set",
-            "steps.count=6",
-        ],
-    );
-}
-
 fn checkpoints(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = fs::read_dir(dir.join("c.out/checkpoints"))
         .map(|d| {
@@ -151,7 +134,7 @@ exit 1
 #[test]
 fn run_case_splits_resumes_and_completes_without_a_scheduler() {
     let dir = workdir("jobs-run-case");
-    small_cantilever(&dir);
+    small_cantilever(&dir, 6, &[]);
     let env = [("RANKS", "2"), ("STEPS_PER_JOB", "2")];
 
     let (code, log) = call(&dir, "run-case.sh", &["c.h5"], &env);
@@ -193,7 +176,7 @@ fn run_case_splits_resumes_and_completes_without_a_scheduler() {
 #[test]
 fn run_case_skips_an_unreadable_newest_checkpoint() {
     let dir = workdir("jobs-torn-checkpoint");
-    small_cantilever(&dir);
+    small_cantilever(&dir, 6, &[]);
     let env = [("RANKS", "2"), ("STEPS_PER_JOB", "2")];
     let (code, log) = call(&dir, "run-case.sh", &["c.h5"], &env);
     assert_eq!(code, 99, "{log}");
@@ -212,7 +195,7 @@ fn run_case_skips_an_unreadable_newest_checkpoint() {
 #[test]
 fn run_case_passes_petsc_options_and_forwards_a_stop_signal_as_usr1() {
     let dir = workdir("jobs-signal");
-    small_cantilever(&dir);
+    small_cantilever(&dir, 6, &[]);
     let launcher = fake_launcher(&dir);
     let child = script(
         &dir,
@@ -274,20 +257,7 @@ fn run_case_passes_petsc_options_and_forwards_a_stop_signal_as_usr1() {
 #[test]
 fn run_case_stopped_by_sigterm_checkpoints_and_resumes() {
     let dir = workdir("jobs-sigterm");
-    ok(
-        &dir,
-        1,
-        &[
-            "new",
-            "cantilever",
-            "-o",
-            "c.h5",
-            "--set",
-            "mesh.h=0.25",
-            "--set",
-            "steps.count=2000",
-        ],
-    );
+    small_cantilever(&dir, 2000, &[]);
     let child = script(&dir, "run-case.sh", &["c.h5"], &[("RANKS", "2")])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -340,7 +310,7 @@ fn run_case_stopped_by_sigterm_checkpoints_and_resumes() {
 #[test]
 fn run_case_reports_a_failed_launch() {
     let dir = workdir("jobs-failure");
-    small_cantilever(&dir);
+    small_cantilever(&dir, 6, &[]);
     let (code, log) = call(&dir, "run-case.sh", &["c.h5"], &[("MPIRUN", "false")]);
     assert!(
         code != 0 && code != 99,
@@ -389,7 +359,7 @@ fn submitted(dir: &Path) -> Vec<String> {
 #[test]
 fn slurm_script_chains_until_done_and_stops_at_max_chain_or_failure() {
     let dir = workdir("jobs-slurm");
-    small_cantilever(&dir);
+    small_cantilever(&dir, 6, &[]);
     let path = fake_scheduler(&dir);
     let slurm = |extra: &[(&str, &str)]| {
         let mut env = vec![
@@ -438,7 +408,7 @@ fn slurm_script_chains_until_done_and_stops_at_max_chain_or_failure() {
 #[test]
 fn pbs_script_stops_the_solver_before_the_walltime_and_chains() {
     let dir = workdir("jobs-pbs");
-    small_cantilever(&dir);
+    small_cantilever(&dir, 6, &[]);
     let path = fake_scheduler(&dir);
     let launcher = fake_launcher(&dir);
     let job_script = jobs().join("pbs.pbs");

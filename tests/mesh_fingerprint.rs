@@ -63,20 +63,7 @@ fn random_cloud_mesh_is_rank_count_independent() {
 #[test]
 fn deformed_cloud_mesh_is_rank_count_independent() {
     let dir = workdir("fp-deformed");
-    ok(
-        &dir,
-        1,
-        &[
-            "new",
-            "cantilever",
-            "-o",
-            "c.h5",
-            "--set",
-            "mesh.h=0.25",
-            "--set",
-            "steps.count=10",
-        ],
-    );
+    small_cantilever(&dir, 10, &[]);
     ok(&dir, 2, &["c.h5"]);
     let bent = "c.out/checkpoints/step_000010.h5";
     let lines = fingerprints(&dir, bent);

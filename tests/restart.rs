@@ -8,23 +8,6 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-fn small_case(dir: &Path, steps: u32) {
-    ok(
-        dir,
-        1,
-        &[
-            "new",
-            "cantilever",
-            "-o",
-            "c.h5",
-            "--set",
-            "mesh.h=0.25",
-            "--set",
-            &format!("steps.count={steps}"),
-        ],
-    );
-}
-
 fn rows(dir: &Path, out: &str) -> Vec<Vec<f64>> {
     history(&dir.join(out).join("history.csv")).1
 }
@@ -34,7 +17,7 @@ fn rows(dir: &Path, out: &str) -> Vec<Vec<f64>> {
 #[test]
 fn restart_on_one_rank_is_bitwise() {
     let dir = workdir("restart1");
-    small_case(&dir, 8);
+    small_cantilever(&dir, 8, &[]);
     ok(&dir, 1, &["c.h5", "--out", "full"]);
     ok(&dir, 1, &["c.h5", "--out", "split", "--until-step", "3"]);
     ok(&dir, 1, &["split/checkpoints/step_000003.h5"]);
@@ -44,7 +27,7 @@ fn restart_on_one_rank_is_bitwise() {
 #[test]
 fn restart_on_same_and_other_rank_counts() {
     let dir = workdir("restart");
-    small_case(&dir, 10);
+    small_cantilever(&dir, 10, &[]);
     let det = ["--", "-pc_factor_mat_solver_type", "superlu_dist"];
     ok(&dir, 2, &[&["c.h5", "--out", "full"][..], &det].concat());
     ok(
@@ -128,7 +111,7 @@ fn checkpoints(dir: &Path) -> Vec<String> {
 #[test]
 fn sigterm_and_sigusr1_checkpoint_and_exit_zero() {
     let dir = workdir("signals");
-    small_case(&dir, 2000);
+    small_cantilever(&dir, 2000, &[]);
     for (ranks, sig, out) in [(None, "-TERM", "one"), (Some(2), "-USR1", "two")] {
         let mut child = spawn(&dir, ranks, &["c.h5", "--out", out]);
         std::thread::sleep(Duration::from_millis(2500));

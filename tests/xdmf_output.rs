@@ -4,23 +4,14 @@
 //! per process, so the writing happens in the example binary.
 
 mod common;
-use common::{example_binary, run_captured as run};
+use common::{example_binary, mpirun_example, run_captured as run};
 use std::path::Path;
 use std::process::{Command, Stdio};
 
 const EXAMPLE: &str = "xdmf_selftest";
 
 fn write_on(binary: &Path, ranks: u32, dir: &Path) -> Result<String, String> {
-    let mut cmd = Command::new("mpirun");
-    cmd.args(["-n", &ranks.to_string(), "--oversubscribe"])
-        .arg(binary)
-        .arg(dir)
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1");
-    run(
-        cmd,
-        &format!("mpirun -n {ranks} {EXAMPLE} (is OpenMPI installed?)"),
-    )
+    mpirun_example(binary, ranks, &[dir.as_os_str()])
 }
 
 fn check_with_python(dir: &Path) -> Result<String, String> {

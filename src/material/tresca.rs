@@ -149,14 +149,13 @@ impl Material for Tresca {
         state_n: &GaussState,
         e: &[f64; 4],
     ) -> Result<MaterialResponse, MaterialError> {
-        if e.iter().any(|v| !v.is_finite()) {
-            return Err(MaterialError::NonFiniteStrain { strain: *e });
+        // The elastic trial state is the linear-elastic update (which also rejects bad strains).
+        let trial = LinearElastic {
+            young: self.young,
+            poisson: self.poisson,
         }
-        let d_el = self.elastic_stiffness();
-        let mut s = state_n.stress;
-        for (si, row) in s.iter_mut().zip(d_el.iter()) {
-            *si += row.iter().zip(e.iter()).map(|(d, ej)| d * ej).sum::<f64>();
-        }
+        .update(state_n, e)?;
+        let (mut s, d_el) = (trial.s, trial.d);
         let a = 0.5 * (s[0] - s[1]);
         let tau = s[3];
         let r = a.hypot(tau);

@@ -86,3 +86,19 @@ pub fn run_captured(mut cmd: Command, what: &str) -> Result<String, String> {
         Err(e) => Err(format!("{what}: {e}\nstdout:\n{out}\nstderr:\n{err}")),
     }
 }
+
+/// Runs an example binary under `mpirun -n ranks` (oversubscribed, allowed as root), with its
+/// output captured and a time limit.
+pub fn mpirun_example(
+    binary: &Path,
+    ranks: u32,
+    args: &[&std::ffi::OsStr],
+) -> Result<String, String> {
+    let mut cmd = Command::new("mpirun");
+    cmd.args(["-n", &ranks.to_string(), "--oversubscribe"])
+        .arg(binary)
+        .args(args)
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1");
+    run_captured(cmd, &format!("mpirun -n {ranks} (is OpenMPI installed?)"))
+}

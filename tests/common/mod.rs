@@ -4,7 +4,7 @@
 
 mod launch;
 #[allow(unused_imports)]
-pub use launch::{example_binary, run_captured};
+pub use launch::{example_binary, mpirun_example, run_captured};
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -70,4 +70,24 @@ pub fn history(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
         .map(|l| l.split(',').map(|v| v.parse().expect("number")).collect())
         .collect();
     (header, rows)
+}
+
+/// `pfem-mpi new cantilever -o c.h5` with h = 0.25 m (205 particles) and `steps` load steps, plus
+/// any further `--set key=value` overrides: the small case most run tests need.
+pub fn small_cantilever(dir: &Path, steps: u32, sets: &[&str]) {
+    let steps = format!("steps.count={steps}");
+    let mut args = vec![
+        "new",
+        "cantilever",
+        "-o",
+        "c.h5",
+        "--set",
+        "mesh.h=0.25",
+        "--set",
+        &steps,
+    ];
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    ok(dir, 1, &args);
 }
