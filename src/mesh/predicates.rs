@@ -114,15 +114,11 @@ fn lift_cofactor(p: [[f64; 2]; 4], i: usize) -> f64 {
 mod tests {
     use super::*;
 
-    /// SplitMix64: deterministic test randomness without extra dependencies.
+    /// Deterministic test randomness (SplitMix64, `crate::rng`).
     struct Rng(u64);
     impl Rng {
         fn next(&mut self) -> u64 {
-            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^ (z >> 31)
+            crate::rng::next(&mut self.0)
         }
         fn int(&mut self, lo: i64, hi: i64) -> i64 {
             lo + (self.next() % ((hi - lo + 1) as u64)) as i64

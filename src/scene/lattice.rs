@@ -162,18 +162,10 @@ fn jittered(scene: &Scene, gid: u64, p: [f64; 2]) -> [f64; 2] {
     if j == 0.0 || !inside {
         return p;
     }
-    let a = splitmix64(gid.wrapping_mul(2));
-    let b = splitmix64(gid.wrapping_mul(2) + 1);
+    let a = crate::rng::splitmix64(gid.wrapping_mul(2));
+    let b = crate::rng::splitmix64(gid.wrapping_mul(2) + 1);
     let unit = |x: u64| (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
     [p[0] + 2.0 * j * h * unit(a), p[1] + 2.0 * j * h * unit(b)]
-}
-
-/// SplitMix64: a fixed, portable stream of pseudo-random bits from an integer.
-fn splitmix64(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 /// Global id of the particle nearest to `p` (ties go to the smaller id), with its distance.
