@@ -26,6 +26,8 @@ pub struct Measures {
     pub area: f64,
     /// Current horizontal extent of the particles of the first `[[prescribed]]` entry.
     pub driven_width: f64,
+    /// Current right end of that extent.
+    pub driven_right: f64,
 }
 
 /// Normalised values of a row (after `step`).
@@ -52,7 +54,9 @@ pub fn row(scene: &Scene, m: &Measures) -> Result<Vec<f64>, String> {
         }
         HistoryKind::Footing => {
             // Half model: the footing runs from the symmetry plane (the body's left side) to the
-            // prescribed region's right end, and q = F / B on the full footing = F_half / (B/2).
+            // prescribed region's right end. q is the mean pressure F / B on the full footing,
+            // with B its current width: the smooth footing's particles spread sideways as the soil
+            // under it flows out, and the force is carried over their current extent.
             let p = scene
                 .prescribed
                 .first()
@@ -61,7 +65,8 @@ pub fn row(scene: &Scene, m: &Measures) -> Result<Vec<f64>, String> {
             let half = p.region.interval(crate::scene::Axis::X).1.min(x1) - x0;
             let b = 2.0 * half;
             let z = -m.load_factor * p.total[1];
-            Ok(vec![z / b, -m.reaction[1] / half / scene.material.cu])
+            let half_now = if m.driven_right > x0 { m.driven_right - x0 } else { half };
+            Ok(vec![z / b, -m.reaction[1] / half_now / scene.material.cu])
         }
         HistoryKind::Block => {
             let [[_, y0], [_, y1]] = scene.bounding_box();

@@ -200,13 +200,15 @@ impl Simulation {
                 self.last_area,
             ],
         );
-        let width = max_f64(world, hi) + max_f64(world, -lo);
+        let right = max_f64(world, hi);
+        let width = right + max_f64(world, -lo);
         Measures {
             load_factor: self.header.load_factor,
             tracked_displacement: [s[0], s[1]],
             reaction: [s[2], s[3]],
             area: s[4],
             driven_width: width,
+            driven_right: right,
         }
     }
 
