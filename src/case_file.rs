@@ -52,7 +52,7 @@ use mpi::traits::*;
 
 pub use collective::block_range;
 pub use error::{CaseError, CaseErrorKind};
-pub use gauss::{GaussRecords, GAUSS_LEN};
+pub use gauss::{GaussRecords, GAUSS_LEN, NODE_LEN};
 pub use particles::{ParticleSet, STATE_LEN};
 
 use crate::scene::{generate_particles, lattice, Scene};

@@ -65,7 +65,11 @@ pub fn row(scene: &Scene, m: &Measures) -> Result<Vec<f64>, String> {
             let half = p.region.interval(crate::scene::Axis::X).1.min(x1) - x0;
             let b = 2.0 * half;
             let z = -m.load_factor * p.total[1];
-            let half_now = if m.driven_right > x0 { m.driven_right - x0 } else { half };
+            let half_now = if m.driven_right > x0 {
+                m.driven_right - x0
+            } else {
+                half
+            };
             Ok(vec![z / b, -m.reaction[1] / half_now / scene.material.cu])
         }
         HistoryKind::Block => {

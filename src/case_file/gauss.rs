@@ -1,6 +1,7 @@
 //! Group `/gauss` of a checkpoint: the Gauss states of every triangle of the mesh the last step
 //! solved on, keyed by the triangle's global ids, so a restart keeps them exactly instead of
-//! re-deriving them from the particles. Absent in new cases.
+//! re-deriving them from the particles, and the last increment's values at the triangle's six
+//! nodes (the next step's Newton predictor). Absent in new cases; `nodes` is optional.
 
 use std::ops::Range;
 use std::path::Path;
@@ -15,6 +16,9 @@ use super::ffi;
 
 /// Values per triangle: 3 Gauss points x 9 state values.
 pub const GAUSS_LEN: usize = 27;
+/// Node values per triangle: 6 nodes (vertices in key order, then the midside nodes of edges
+/// 01, 12, 20) x (displacement increment per whole step x, y; pressure, NaN if none).
+pub const NODE_LEN: usize = 18;
 const GROUP: &str = "gauss";
 
 /// Triangles (smallest-gid vertex first, CCW) with their Gauss states.
@@ -22,6 +26,8 @@ const GROUP: &str = "gauss";
 pub struct GaussRecords {
     pub key: Vec<[u64; 3]>,
     pub state: Vec<[f64; GAUSS_LEN]>,
+    /// NaN where unknown (a file without `nodes`).
+    pub nodes: Vec<[f64; NODE_LEN]>,
 }
 
 impl GaussRecords {
@@ -54,6 +60,14 @@ fn column<T: H5Type>(
 /// Collective: every rank writes its rows `rows` of `n`.
 pub fn write(file: &File, g: &GaussRecords, rows: Range<usize>, n: usize) -> hdf5::Result<()> {
     column(file, "key", 3, n, rows.clone(), g.key.as_flattened())?;
+    column(
+        file,
+        "nodes",
+        NODE_LEN,
+        n,
+        rows.clone(),
+        g.nodes.as_flattened(),
+    )?;
     column(file, "state", GAUSS_LEN, n, rows, g.state.as_flattened())
 }
 
@@ -90,13 +104,30 @@ pub fn read(
     let mut g = GaussRecords {
         key: vec![[0; 3]; rows.len()],
         state: vec![[0.0; GAUSS_LEN]; rows.len()],
+        nodes: vec![[f64::NAN; NODE_LEN]; rows.len()],
     };
+    let nodes = group.dataset("nodes").ok();
+    if let Some(ns) = nodes.as_ref().map(|d| d.shape()) {
+        if ns.len() != 2 || ns[1] != NODE_LEN || ns[0] != ks[0] {
+            return Err(bad(
+                "nodes",
+                format!("expected shape ({}, {NODE_LEN}), found {ns:?}", ks[0]),
+            ));
+        }
+    }
     let read = (|| {
         ffi::read_collective(
             &key,
             &key.space()?.select((rows.clone(), ..))?,
             g.key.as_flattened_mut(),
         )?;
+        if let Some(nodes) = &nodes {
+            ffi::read_collective(
+                nodes,
+                &nodes.space()?.select((rows.clone(), ..))?,
+                g.nodes.as_flattened_mut(),
+            )?;
+        }
         ffi::read_collective(
             &state,
             &state.space()?.select((rows, ..))?,

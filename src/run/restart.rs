@@ -3,7 +3,7 @@
 //! rank whose owned particles touch the triangle.
 
 use super::Simulation;
-use crate::case_file::{write_checkpoint, GaussRecords, ParticleSet, GAUSS_LEN};
+use crate::case_file::{write_checkpoint, GaussRecords, ParticleSet, GAUSS_LEN, NODE_LEN};
 use crate::mapping::TriStates;
 use crate::material::GaussState;
 use crate::particles::flag;
@@ -11,6 +11,20 @@ use mpi::traits::Communicator;
 use pfem_partition::{alltoallv, locate, Comm};
 
 const K: usize = GaussState::LEN;
+
+/// The node keys of a triangle `[a, b, c]`: its vertices, then the midside nodes of edges 01,
+/// 12, 20 (the order of `/gauss/nodes`).
+fn tri_node_keys(t: &[u64; 3]) -> [[u64; 2]; 6] {
+    let edge = |a: u64, b: u64| [a.min(b), a.max(b)];
+    [
+        [t[0], t[0]],
+        [t[1], t[1]],
+        [t[2], t[2]],
+        edge(t[0], t[1]),
+        edge(t[1], t[2]),
+        edge(t[2], t[0]),
+    ]
+}
 
 impl Simulation {
     /// Collective. Writes this state as a case file that any rank count can continue from.
@@ -35,6 +49,14 @@ impl Simulation {
                     flat[q * K..(q + 1) * K].copy_from_slice(&s.to_array());
                 }
                 records.state.push(flat);
+                let last = self.last_nodes.borrow();
+                let mut nodes = [f64::NAN; NODE_LEN];
+                for (k, node) in tri_node_keys(key).iter().enumerate() {
+                    if let Some(v) = last.get(node) {
+                        nodes[3 * k..3 * k + 3].copy_from_slice(v);
+                    }
+                }
+                records.nodes.push(nodes);
             }
         }
         let mut header = self.header.clone();
@@ -42,7 +64,8 @@ impl Simulation {
         write_checkpoint(world, path, &header, &set, &records).map_err(|e| e.to_string())
     }
 
-    /// Collective. Sends each stored triangle to the owners of its vertices.
+    /// Collective. Sends each stored triangle (Gauss states and node values) to the owners of its
+    /// vertices.
     pub(super) fn restore_gauss(&mut self, world: &Comm, records: GaussRecords) {
         let queries: Vec<u64> = records.key.iter().flatten().copied().collect();
         let owners = locate(world, &self.particles.gid, &queries);
@@ -58,12 +81,29 @@ impl Simulation {
             for r in dest {
                 send[r as usize].extend_from_slice(key);
                 send[r as usize].extend(records.state[t].iter().map(|x| x.to_bits()));
+                send[r as usize].extend(records.nodes[t].iter().map(|x| x.to_bits()));
             }
         }
         let received = alltoallv(world, &send);
-        let pairs = received
-            .iter()
-            .flat_map(|r| r.chunks_exact(3 + GAUSS_LEN))
+        let chunks = || {
+            received
+                .iter()
+                .flat_map(|r| r.chunks_exact(3 + GAUSS_LEN + NODE_LEN))
+        };
+        let mut last = self.last_nodes.borrow_mut();
+        last.clear();
+        for c in chunks() {
+            let nodes = &c[3 + GAUSS_LEN..];
+            for (k, node) in tri_node_keys(&[c[0], c[1], c[2]]).iter().enumerate() {
+                let v: [f64; 3] = std::array::from_fn(|i| f64::from_bits(nodes[3 * k + i]));
+                // A node's displacement is NaN only where it was not stored.
+                if !v[0].is_nan() {
+                    last.insert(*node, v);
+                }
+            }
+        }
+        drop(last);
+        let pairs = chunks()
             .map(|c| {
                 let states = std::array::from_fn(|q| {
                     let mut a = [0.0; K];

@@ -27,6 +27,9 @@ pub struct Simulation {
     pub(super) last_area: f64,
     /// PETSc objects of the last increment (kept while the matrix pattern stays the same).
     pub(super) solver: std::cell::RefCell<Option<super::step::SolverObjects>>,
+    /// The last increment's nodal solution by global node ([gid, gid] for a vertex, the sorted
+    /// end ids for a midside node): displacement per whole step and pressure. The next predictor.
+    pub(super) last_nodes: std::cell::RefCell<std::collections::HashMap<[u64; 2], [f64; 3]>>,
     first_step: u64,
 }
 
@@ -77,6 +80,7 @@ impl Simulation {
             last_reaction: [0.0; 2],
             last_area: 0.0,
             solver: Default::default(),
+            last_nodes: Default::default(),
         };
         if world.size() > 1 && !same_partition {
             sim.repartition(world)?;
@@ -221,7 +225,8 @@ impl Simulation {
     }
 
     /// Collective. METIS k-way on the mesh graph of the particles, then migration. Gauss states
-    /// are recovered from the particles afterwards.
+    /// are recovered from the particles afterwards, and the next predictor from the particle
+    /// increments.
     fn repartition(&mut self, world: &Comm) -> Result<(), String> {
         let mesh = self.build_mesh(world)?;
         let n = mesh.n_owned;
@@ -259,6 +264,7 @@ impl Simulation {
         self.particles =
             Particles::from_records(gid, &rec, fl.into_iter().map(|f| f as u32).collect());
         self.tri_states = TriStates::default();
+        self.last_nodes.borrow_mut().clear();
         Ok(())
     }
 }

@@ -58,10 +58,25 @@ pub struct Solved {
     dlambda: f64,
     dofs: DofMap,
     du: Vec<[f64; 2]>,
+    /// Pressure of every local node (NaN without a pressure unknown).
+    pressure: Vec<f64>,
     states: Vec<[GaussState; 3]>,
     reaction: [f64; 2],
     newton_iterations: usize,
     residual_norm: f64,
+}
+
+/// Global identity of local node `n`: a vertex's particle id twice, or an edge's two particle
+/// ids in increasing order.
+fn node_key(mesh: &LocalMesh, dofs: &DofMap, n: usize) -> [u64; 2] {
+    let n_vertex = dofs.n_nodes() - dofs.edges.len();
+    if n < n_vertex {
+        let g = mesh.gids[dofs.node_point[n] as usize];
+        [g, g]
+    } else {
+        let [a, b] = dofs.edges[n - n_vertex].map(|p| mesh.gids[p as usize]);
+        [a.min(b), a.max(b)]
+    }
 }
 
 /// Pressure (compression positive) of a particle state.
@@ -131,10 +146,11 @@ impl Simulation {
         let outcome = self.solve_with(world, mesh, &dofs, setup, &mut cache, scale, step);
         // Kept for the next increment on the same pattern (a cut piece, or an unchanged mesh).
         *self.solver.borrow_mut() = Some(cache);
-        outcome.map(|(du, states, reaction, stats)| Solved {
+        outcome.map(|(du, pressure, states, reaction, stats)| Solved {
             dlambda: to - from,
             dofs,
             du,
+            pressure,
             states,
             reaction,
             newton_iterations: stats.newton_iterations,
@@ -191,6 +207,7 @@ impl Simulation {
     ) -> Result<
         (
             Vec<[f64; 2]>,
+            Vec<f64>,
             Vec<[GaussState; 3]>,
             [f64; 2],
             crate::petsc::SolveStats,
@@ -203,12 +220,18 @@ impl Simulation {
             StepProblem::new(world, mesh, dofs, setup, x).map_err(|e| err(e.to_string()))?;
         // Predictor: the last step's increment (a proportional step's best guess, which also keeps
         // Newton off the zero-energy shear-band modes of a plastic limit state) and the current
-        // pressure.
+        // pressure: the last solution's own nodal values where the node survived the remesh (a
+        // P2 midside value is not the mean of its ends, and a recovered pressure is smoothed),
+        // otherwise the particles' values.
+        let last = self.last_nodes.borrow();
         let inc =
             |p: usize| self.point_value(mesh, p, &self.particles.increment, &self.ghosts.increment);
         let state = |p: usize| self.point_value(mesh, p, &self.particles.state, &self.ghosts.state);
         problem
             .initial_guess(x, |n| {
+                if let Some(v) = last.get(&node_key(mesh, dofs, n)) {
+                    return [scale * v[0], scale * v[1], v[2]];
+                }
                 let p = dofs.node_point[n];
                 if p != u32::MAX {
                     let (d, s) = (inc(p as usize), state(p as usize));
@@ -252,8 +275,10 @@ impl Simulation {
         };
         let reaction = problem.reaction(&elems, driven);
         let du = problem.node_displacements(&local);
+        let pressure = problem.node_pressures(&local);
         Ok((
             du,
+            pressure,
             elems.into_iter().map(|e| e.states).collect(),
             reaction,
             stats,
@@ -284,6 +309,12 @@ impl Simulation {
             }
             self.particles.increment[i] = [per_step * d[0], per_step * d[1]];
         }
+        let last = (0..solved.dofs.n_nodes()).map(|n| {
+            let d = solved.du[n];
+            let v = [per_step * d[0], per_step * d[1], solved.pressure[n]];
+            (node_key(mesh, &solved.dofs, n), v)
+        });
+        *self.last_nodes.borrow_mut() = last.collect();
         self.particles.state = recover_at_particles(mesh, &solved.states, &self.particles.state);
         self.tri_states = TriStates::new(mesh, solved.states);
         self.last_reaction = solved.reaction;

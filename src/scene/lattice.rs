@@ -91,14 +91,17 @@ pub fn generate_particles(scene: &Scene) -> ParticleSet {
             for i in span[0]..=span[1] {
                 let gid = set.len() as u64;
                 let p = [anchor[0] + i as f64 * h, y];
-                set.push_new(gid, jittered(scene, gid, p), h);
+                set.push_new(gid, p, h);
             }
         }
     }
-    if scene.mesh.fine.is_empty() {
-        return set;
+    if !scene.mesh.fine.is_empty() {
+        set = refine_regions(scene, set);
     }
-    refine_regions(scene, set)
+    for i in 0..set.len() {
+        set.position[i] = jittered(scene, set.gid[i], set.position[i], set.h[i]);
+    }
+    set
 }
 
 /// Replaces the lattice inside each `[[mesh.fine]]` region by that region's finer lattice:
@@ -153,9 +156,10 @@ fn refine_regions(scene: &Scene, base: ParticleSet) -> ParticleSet {
     set
 }
 
-/// `p` moved by the scene's `body.jitter` when it lies more than h/2 inside a rectangle.
-fn jittered(scene: &Scene, gid: u64, p: [f64; 2]) -> [f64; 2] {
-    let (h, j) = (scene.mesh.h, scene.body.jitter);
+/// `p` (spacing `h`) moved by the scene's `body.jitter` when it lies more than h/2 inside a
+/// rectangle.
+fn jittered(scene: &Scene, gid: u64, p: [f64; 2], h: f64) -> [f64; 2] {
+    let j = scene.body.jitter;
     let inside = scene.body.rectangles.iter().any(|r| {
         (0..2).all(|c| p[c] > r.origin[c] + 0.5 * h && p[c] < r.origin[c] + r.size[c] - 0.5 * h)
     });

@@ -46,8 +46,10 @@ pub struct Body {
     /// them.
     pub rectangles: Vec<Rectangle>,
     /// Random offset of every particle lying more than h/2 inside a rectangle, as a fraction of
-    /// h in each direction (0 <= jitter < 0.5; default 0). Deterministic per particle id: an
-    /// irregular cloud for studying the mesher, with supports and loads left on the lattice.
+    /// its spacing h (the finer one inside `[[mesh.fine]]` regions) in each direction (0 <=
+    /// jitter < 0.5; default 0). Deterministic per particle id. An irregular cloud has no grid
+    /// lines for the plastic slip lines to cut across (a lattice's collapse loads are higher and
+    /// approached slowly); supports and loads stay on the lattice.
     #[serde(default)]
     pub jitter: f64,
 }

@@ -145,6 +145,21 @@ impl<'a> StepProblem<'a> {
             .collect()
     }
 
+    /// Pressure (compression positive) of every local node at `local`; NaN where the node has
+    /// no pressure unknown.
+    pub fn node_pressures(&self, local: &[f64]) -> Vec<f64> {
+        let scale = self.pressure_scale();
+        (0..self.dofs.n_nodes())
+            .map(|n| {
+                if self.dofs.ndof(n) == 3 {
+                    scale * local[self.dofs.node_local[n] + 2]
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect()
+    }
+
     /// Evaluates every local triangle at the local vector `local`.
     pub fn elements(&self, local: &[f64]) -> Result<Vec<ElementResult>, String> {
         let s = &self.setup;
