@@ -3,7 +3,7 @@
 use crate::material::elastic::LinearElastic;
 use crate::material::tresca::Tresca;
 use crate::material::Material;
-use crate::scene::{ElementChoice, MaterialModel, Scene};
+use crate::scene::{Axis, ElementChoice, MaterialModel, Prescribed, Scene, Selection};
 use crate::solve::Kernel;
 
 pub struct Model {
@@ -75,33 +75,96 @@ impl Model {
         step as f64 / self.scene.steps.count as f64
     }
 
-    /// Prescribed displacement increment for a load-factor increment `dlambda` (1/steps for a
-    /// whole step) for a particle at reference position `x`.
-    pub fn step_bc(&self, x: [f64; 2], dlambda: f64) -> [Option<f64>; 2] {
+    /// Prescribed displacement increment, from load factor `from` to `to`, of a particle at
+    /// reference position `x0` and current position `x`.
+    pub fn step_bc(&self, x0: [f64; 2], x: [f64; 2], from: f64, to: f64) -> [Option<f64>; 2] {
         let mut bc = [None, None];
         for f in &self.scene.fixed {
-            if f.region.matches(x, self.tol) {
+            if f.region.matches(x0, self.tol) {
                 for d in &f.dofs {
                     bc[d.index()] = Some(0.0);
                 }
             }
         }
         for p in &self.scene.prescribed {
-            if p.region.matches(x, self.tol) {
-                for d in &p.dofs {
-                    bc[d.index()] = Some(p.total[d.index()] * dlambda);
-                }
+            if !self.selects(p, x0, x, from) {
+                continue;
+            }
+            for d in &p.dofs {
+                let c = d.index();
+                bc[c] = Some(match p.select {
+                    Selection::Initial => p.total[c] * (to - from),
+                    // Onto the platen's face where it will be: a particle that has just reached
+                    // the platen is put on it.
+                    Selection::Current => face(p, c) + p.total[c] * to - x[c],
+                });
             }
         }
         bc
     }
 
-    /// Whether a particle at reference position `x` is driven by the first `[[prescribed]]`
-    /// entry (the footing, the top platen): history reports the force on it.
-    pub fn in_first_prescribed(&self, x: [f64; 2]) -> bool {
+    /// Whether a particle (reference position `x0`, current `x`) is driven by the first
+    /// `[[prescribed]]` entry (the footing, the top platen) at load factor `lambda`: history
+    /// reports the force on it.
+    pub fn in_first_prescribed(&self, x0: [f64; 2], x: [f64; 2], lambda: f64) -> bool {
         self.scene
             .prescribed
             .first()
-            .is_some_and(|p| p.region.matches(x, self.tol))
+            .is_some_and(|p| self.selects(p, x0, x, lambda))
+    }
+
+    fn selects(&self, p: &Prescribed, x0: [f64; 2], x: [f64; 2], lambda: f64) -> bool {
+        match p.select {
+            Selection::Initial => p.region.matches(x0, self.tol),
+            Selection::Current => {
+                let mut back = x;
+                for d in &p.dofs {
+                    back[d.index()] -= p.total[d.index()] * lambda;
+                }
+                p.region.matches(back, self.tol)
+            }
+        }
+    }
+}
+
+/// The initial face of a `select = "current"` platen along component `c`: the one finite bound
+/// of `where` (validation guarantees it).
+fn face(p: &Prescribed, c: usize) -> f64 {
+    let axis = if c == 0 { Axis::X } else { Axis::Y };
+    let (lo, hi) = p.region.interval(axis);
+    if lo.is_finite() {
+        lo
+    } else {
+        hi
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::load_scene;
+
+    #[test]
+    fn rigid_platen_takes_particles_that_reach_it_onto_its_face() {
+        // Top platen "y >= 1", total -0.25 over the run, `select = "current"`.
+        let (scene, _) = load_scene("block-compression", &[]).unwrap();
+        let model = Model::new(&scene).unwrap();
+        let (from, to) = (0.4, 0.41);
+        let face_to = 1.0 - 0.25 * to;
+        // On the face: moves with the platen.
+        let on = [0.3, 1.0 - 0.25 * from];
+        let bc = model.step_bc([0.3, 1.0], on, from, to);
+        assert!((bc[1].unwrap() - (face_to - on[1])).abs() < 1e-15);
+        assert!((bc[1].unwrap() + 0.25 * 0.01).abs() < 1e-12);
+        assert_eq!(bc[0], None, "smooth: horizontally free");
+        // A side particle that bulged past the face is put back on it.
+        let past = [1.2, 1.0 - 0.25 * from + 0.003];
+        let bc = model.step_bc([1.0, 0.9], past, from, to);
+        assert!((past[1] + bc[1].unwrap() - face_to).abs() < 1e-15);
+        // One still below the face is free, whatever its initial position.
+        let below = [0.5, 1.0 - 0.25 * from - 0.01];
+        assert_eq!(model.step_bc([0.5, 1.0], below, from, to), [None, None]);
+        assert!(model.in_first_prescribed([1.0, 0.9], past, from));
+        assert!(!model.in_first_prescribed([0.5, 1.0], below, from));
     }
 }

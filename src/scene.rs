@@ -74,7 +74,7 @@ pub use error::SceneError;
 pub use lattice::generate_particles;
 pub use schema::{
     Body, Dof, ElementChoice, FineRegion, Fixed, Gravity, History, HistoryKind, Material,
-    MaterialModel, Mesh, Output, PointLoad, Prescribed, Rectangle, Scene, Solver, Steps,
+    MaterialModel, Mesh, Output, PointLoad, Prescribed, Rectangle, Scene, Selection, Solver, Steps,
 };
 pub use selector::{Axis, Comparison, Condition, Selector};
 

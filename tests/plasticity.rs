@@ -1,7 +1,8 @@
 //! Tresca clay with the mixed P2–P1 element through the whole PFEM loop (remeshing every step):
-//! plane-strain compression between smooth platens holds the exact 2·cu once yielded and keeps
-//! the volume, on 1 and 2 ranks. (To 10 % strain here: beyond about 15 % the homogeneous
-//! solution bifurcates in this model and Newton stalls — see the README.)
+//! plane-strain compression between smooth rigid platens holds the exact 2·cu once yielded and
+//! keeps the volume, on 1 and 2 ranks. (To 15 % strain here: beyond that the homogeneous solution
+//! of this perfectly plastic model bifurcates into shear bands, from round-off, at a strain that
+//! depends on the rank count — see the README.)
 
 mod common;
 use common::*;
@@ -18,11 +19,11 @@ fn block_compression_holds_two_cu_and_the_volume() {
             "-o",
             "b.h5",
             "--set",
-            "steps.count=20",
+            "steps.count=30",
             "--set",
-            "prescribed[0].total=[0.0,-0.05]",
+            "prescribed[0].total=[0.0,-0.075]",
             "--set",
-            "prescribed[1].total=[0.0,0.05]",
+            "prescribed[1].total=[0.0,0.075]",
         ],
     );
     for ranks in [1, 2] {
@@ -30,8 +31,8 @@ fn block_compression_holds_two_cu_and_the_volume() {
         ok(&dir, ranks, &["b.h5", "--out", &out]);
         let (header, rows) = history(&dir.join(&out).join("history.csv"));
         assert_eq!(header, ["step", "strain", "stress_over_cu", "volume_ratio"]);
-        assert_eq!(rows.len(), 20);
-        assert!((rows[19][1] - 0.1).abs() < 1e-12, "strain {}", rows[19][1]);
+        assert_eq!(rows.len(), 30);
+        assert!((rows[29][1] - 0.15).abs() < 1e-12, "strain {}", rows[29][1]);
         let mut worst_stress: f64 = 0.0;
         let mut worst_volume: f64 = 0.0;
         for r in &rows[1..] {

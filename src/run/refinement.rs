@@ -29,7 +29,12 @@ impl Simulation {
                 || mesh.on_boundary[p]
                 || self
                     .model
-                    .step_bc(self.particles.reference_position(p), 1.0)
+                    .step_bc(
+                        self.particles.reference_position(p),
+                        self.particles.position[p],
+                        self.header.load_factor,
+                        self.header.load_factor,
+                    )
                     .iter()
                     .any(Option::is_some)
         };

@@ -186,10 +186,11 @@ impl Simulation {
         }
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for i in 0..self.particles.len() {
-            if self
-                .model
-                .in_first_prescribed(self.particles.reference_position(i))
-            {
+            if self.model.in_first_prescribed(
+                self.particles.reference_position(i),
+                self.particles.position[i],
+                self.header.load_factor,
+            ) {
                 lo = lo.min(self.particles.position[i][0]);
                 hi = hi.max(self.particles.position[i][0]);
             }

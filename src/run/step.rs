@@ -112,7 +112,7 @@ impl Simulation {
             DofMap::build(world, mesh, self.model.mixed()).map_err(|e| err(e.to_string()))?;
         let constraints = Constraints::build(&dofs, |p| {
             self.model
-                .step_bc(self.reference_position(mesh, p), to - from)
+                .step_bc(self.reference_position(mesh, p), mesh.points[p], from, to)
         });
         // The last increment scaled to this one is the predictor.
         let scale = (to - from) * self.model.scene.steps.count as f64;
@@ -143,7 +143,7 @@ impl Simulation {
         let mut cache = self
             .solver_objects(world, &dofs)
             .map_err(|e| err(e.to_string()))?;
-        let outcome = self.solve_with(world, mesh, &dofs, setup, &mut cache, scale, step);
+        let outcome = self.solve_with(world, mesh, &dofs, setup, &mut cache, scale, from, step);
         // Kept for the next increment on the same pattern (a cut piece, or an unchanged mesh).
         *self.solver.borrow_mut() = Some(cache);
         outcome.map(|(du, pressure, states, reaction, stats)| Solved {
@@ -203,6 +203,7 @@ impl Simulation {
         setup: StepSetup,
         objects: &mut SolverObjects,
         scale: f64,
+        from: f64,
         step: u64,
     ) -> Result<
         (
@@ -269,8 +270,12 @@ impl Simulation {
                 dofs.edges[n - n_vertex].to_vec()
             };
             pts.iter().all(|&p| {
-                self.model
-                    .in_first_prescribed(self.reference_position(mesh, p as usize))
+                let p = p as usize;
+                self.model.in_first_prescribed(
+                    self.reference_position(mesh, p),
+                    mesh.points[p],
+                    from,
+                )
             })
         };
         let reaction = problem.reaction(&elems, driven);

@@ -205,8 +205,7 @@ pub struct PointLoad {
     pub force: [f64; 2],
 }
 
-/// `[[prescribed]]`: imposed displacement of the particles selected by `where` in the initial
-/// configuration.
+/// `[[prescribed]]`: imposed displacement of the particles selected by `where`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Prescribed {
@@ -218,6 +217,31 @@ pub struct Prescribed {
     /// Displacement (m) reached at the end of loading, applied linearly over the steps. Only the
     /// components listed in `dofs` are used.
     pub total: [f64; 2],
+    /// Which particles `where` selects. Default `"initial"`.
+    #[serde(default, skip_serializing_if = "Selection::is_initial")]
+    pub select: Selection,
+}
+
+/// How `[[prescribed]].where` selects particles.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Selection {
+    /// `"initial"`: the particles whose initial position lies in `where`, for the whole run (a
+    /// platen glued to the body).
+    #[default]
+    Initial,
+    /// `"current"`: a rigid platen. `where` moves with the prescribed displacement, and at the
+    /// start of every increment it selects the particles now inside it: every particle that
+    /// reaches the platen is put on its face and moves with it from then on, so the body never
+    /// passes through it. Each prescribed component must be bounded on one side only in `where`
+    /// (`y >= 1`: the face is y = 1 plus the platen's displacement).
+    Current,
+}
+
+impl Selection {
+    fn is_initial(&self) -> bool {
+        *self == Selection::Initial
+    }
 }
 
 /// `[steps]`: load stepping.

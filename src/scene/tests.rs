@@ -380,3 +380,21 @@ fn load_scene_by_path_and_unknown_name() {
     assert!(resolved.contains("count = 7"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn rigid_platen_needs_a_one_sided_face() {
+    let set = |w: &str| {
+        load_scene("block-compression", &[format!("prescribed[0].where={w}")]).map(|(s, _)| s)
+    };
+    let (block, _) = load_scene("block-compression", &[]).unwrap();
+    assert_eq!(block.prescribed[0].select, Selection::Current);
+    let e = set("\"y >= 1 and y <= 2\"").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("prescribed[0].where"), "{e}");
+    assert!(e.message.contains("bounded on one side only in y"), "{e}");
+    let e = load_scene(
+        "block-compression",
+        &["prescribed[0].select=\"now\"".into()],
+    )
+    .unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("prescribed[0].select"), "{e}");
+}

@@ -5,8 +5,8 @@ use std::collections::HashSet;
 
 use super::field_path::FieldPath;
 use super::lattice::{self, generate_particles};
-use super::schema::{Dof, HistoryKind, MaterialModel, Scene};
-use super::selector::Selector;
+use super::schema::{Dof, HistoryKind, MaterialModel, Scene, Selection};
+use super::selector::{Axis, Selector};
 
 /// Upper bound on the initial particle count, so that a mistyped `mesh.h` is reported instead
 /// of exhausting memory.
@@ -157,6 +157,23 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
         let path = root.join("prescribed").at(i);
         dofs(path.join("dofs"), &p.dofs)?;
         finite2(path.join("total"), p.total)?;
+        if p.select == Selection::Current {
+            for d in &p.dofs {
+                let axis = if d.index() == 0 { Axis::X } else { Axis::Y };
+                let (lo, hi) = p.region.interval(axis);
+                if lo.is_finite() == hi.is_finite() {
+                    return fail(
+                        path.join("where"),
+                        format!(
+                            "select = \"current\" needs `where` bounded on one side only in {} \
+                             (the platen's face), e.g. \"{} >= 1\"",
+                            d.as_str(),
+                            d.as_str()
+                        ),
+                    );
+                }
+            }
+        }
     }
 
     if s.steps.count < 1 {
