@@ -1,7 +1,7 @@
 //! Prandtl's bearing capacity through the whole PFEM loop: the built-in `footing-shallow` (smooth
 //! strip on stiff Tresca clay, graded jittered cloud, remeshing every step) reaches a flat plateau
 //! within 1 % of (2 + π)·cu on its default mesh, and the same grading coarsened twice and four
-//! times converges to it from above at first order. Histories agree across rank counts.
+//! times converges to it from above at first order. Histories agree across 1, 2 and 3 ranks.
 
 mod common;
 use common::*;
@@ -69,9 +69,13 @@ fn coarse_gradings_converge_to_prandtl_from_above() {
             (end - start) / start < 0.005,
             "{name}: no plateau: {start} -> {end}"
         );
-        let (start2, end2) = plateau(&dir, name, 2);
-        for (a, b) in [(start, start2), (end, end2)] {
-            assert!((a - b).abs() < 1e-6 * a, "{name}: 1 rank {a}, 2 ranks {b}");
+        // The saddle points solve with the default options on 2 and 3 ranks to the same curve.
+        let more: &[usize] = if name == "h4" { &[2, 3] } else { &[2] };
+        for &ranks in more {
+            let (s, e) = plateau(&dir, name, ranks);
+            for (a, b) in [(start, s), (end, e)] {
+                assert!((a - b).abs() < 1e-6 * a, "{name}: 1 rank {a}, {ranks} ranks {b}");
+            }
         }
         errors.push(error(end));
     }
