@@ -74,7 +74,10 @@ fn coarse_gradings_converge_to_prandtl_from_above() {
         for &ranks in more {
             let (s, e) = plateau(&dir, name, ranks);
             for (a, b) in [(start, s), (end, e)] {
-                assert!((a - b).abs() < 1e-6 * a, "{name}: 1 rank {a}, {ranks} ranks {b}");
+                assert!(
+                    (a - b).abs() < 1e-6 * a,
+                    "{name}: 1 rank {a}, {ranks} ranks {b}"
+                );
             }
         }
         errors.push(error(end));
