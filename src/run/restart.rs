@@ -15,7 +15,7 @@ const K: usize = GaussState::LEN;
 /// The node keys of a triangle `[a, b, c]`: its vertices, then the midside nodes of edges 01,
 /// 12, 20 (the order of `/gauss/nodes`).
 fn tri_node_keys(t: &[u64; 3]) -> [[u64; 2]; 6] {
-    let edge = |a: u64, b: u64| [a.min(b), a.max(b)];
+    let edge = super::step::edge_key;
     [
         [t[0], t[0]],
         [t[1], t[1]],
@@ -40,6 +40,7 @@ impl Simulation {
             flags: p.flags.iter().map(|f| f & !flag::TRACKED).collect(),
         };
         let mut records = GaussRecords::default();
+        let last = self.last_nodes.borrow();
         for (key, states) in self.tri_states.iter() {
             // Each triangle once: by the owner of its smallest-gid vertex.
             if p.gid.binary_search(&key[0]).is_ok() {
@@ -49,7 +50,6 @@ impl Simulation {
                     flat[q * K..(q + 1) * K].copy_from_slice(&s.to_array());
                 }
                 records.state.push(flat);
-                let last = self.last_nodes.borrow();
                 let mut nodes = [f64::NAN; NODE_LEN];
                 for (k, node) in tri_node_keys(key).iter().enumerate() {
                     if let Some(v) = last.get(node) {

@@ -75,8 +75,13 @@ fn node_key(mesh: &LocalMesh, dofs: &DofMap, n: usize) -> [u64; 2] {
         [g, g]
     } else {
         let [a, b] = dofs.edges[n - n_vertex].map(|p| mesh.gids[p as usize]);
-        [a.min(b), a.max(b)]
+        edge_key(a, b)
     }
+}
+
+/// Key of the midside node between particles `a` and `b`.
+pub(super) fn edge_key(a: u64, b: u64) -> [u64; 2] {
+    [a.min(b), a.max(b)]
 }
 
 /// Pressure (compression positive) of a particle state.
