@@ -73,8 +73,9 @@ pub use builtin::{builtin, builtin_names, BUILTINS};
 pub use error::SceneError;
 pub use lattice::generate_particles;
 pub use schema::{
-    Body, Dof, ElementChoice, FineRegion, Fixed, Gravity, History, HistoryKind, Material,
-    MaterialModel, Mesh, Output, PointLoad, Prescribed, Rectangle, Scene, Selection, Solver, Steps,
+    Body, Dof, ElementChoice, FineRegion, Fixed, Gravity, History, HistoryKind, LineSearch,
+    Material, MaterialModel, Mesh, Output, PointLoad, Prescribed, Rectangle, Scene, Selection,
+    Solver, Steps,
 };
 pub use selector::{Axis, Comparison, Condition, Selector};
 

@@ -161,6 +161,27 @@ impl Snes {
                 ffi::SNESGetFunctionNorm(self.raw, &mut norm),
                 "SNESGetFunctionNorm",
             )?;
+            let mut lambda = 1.0;
+            if reason == ffi::SNESConvergedReason_SNES_CONVERGED_SNORM_RELATIVE {
+                let mut ls: ffi::SNESLineSearch = std::ptr::null_mut();
+                check(
+                    ffi::SNESGetLineSearch(self.raw, &mut ls),
+                    "SNESGetLineSearch",
+                )?;
+                check(
+                    ffi::SNESLineSearchGetLambda(ls, &mut lambda),
+                    "SNESLineSearchGetLambda",
+                )?;
+            }
+            // A tiny update is convergence only when the line search took (about) the whole
+            // Newton step; a strongly damped step is tiny because Newton is stuck, whatever the
+            // residual.
+            if lambda < 0.5 {
+                return Err(PetscError {
+                    code: DIVERGED,
+                    message: format!("Newton stalled (update below {STEP_TOL:e} of the solution after a step damped to {lambda:.1e}) after {its} iterations, residual {norm:.3e}"),
+                });
+            }
             if reason < 0 {
                 let mut text: *const std::os::raw::c_char = std::ptr::null();
                 check(

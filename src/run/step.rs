@@ -6,6 +6,7 @@ use crate::mapping::{recover_at_particles, TriStates};
 use crate::material::GaussState;
 use crate::mesh::LocalMesh;
 use crate::petsc::{Mat, PVec, Petsc, Snes};
+use crate::scene::LineSearch;
 use crate::solve::{Constraints, DofMap, StepProblem, StepSetup};
 use pfem_partition::{sum_f64, Comm};
 
@@ -184,7 +185,13 @@ impl Simulation {
         let (d_nnz, o_nnz) = dofs.preallocation();
         let jac = Mat::aij(world, dofs.n_owned_dofs, &d_nnz, &o_nnz)?;
         let solver = &self.model.scene.solver;
-        let line_search = if self.model.plastic() { "bt" } else { "basic" };
+        let line_search = match solver.line_search {
+            LineSearch::Auto if self.model.plastic() => "bt",
+            LineSearch::Auto | LineSearch::Basic => "basic",
+            LineSearch::Bt => "bt",
+            LineSearch::L2 => "l2",
+            LineSearch::Cp => "cp",
+        };
         let snes = Snes::new(
             world,
             solver.newton_rtol,

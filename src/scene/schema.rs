@@ -316,6 +316,23 @@ pub struct Solver {
     /// `"auto"` (default: `"p2p1"` for `"tresca"`, `"p2"` otherwise), `"p2"` (6-node displacement
     /// triangles) or `"p2p1"` (Taylor–Hood mixed u–p: P2 displacement, P1 pressure).
     pub element: ElementChoice,
+    /// Newton's line search: `"auto"` (default: `"basic"`, full steps, for elastic scenes;
+    /// `"bt"`, backtracking, for plastic ones), `"basic"`, `"bt"`, `"l2"` (secant on the
+    /// residual norm, more evaluations per iteration but it carries localised plastic flow
+    /// further) or `"cp"`. `-snes_linesearch_type` on the command line overrides it.
+    pub line_search: LineSearch,
+}
+
+/// `solver.line_search`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LineSearch {
+    #[default]
+    Auto,
+    Basic,
+    Bt,
+    L2,
+    Cp,
 }
 
 /// `solver.element`.
@@ -334,6 +351,7 @@ impl Default for Solver {
             newton_max_it: 25,
             newton_rtol: 1e-9,
             element: ElementChoice::Auto,
+            line_search: LineSearch::Auto,
         }
     }
 }

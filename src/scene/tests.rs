@@ -398,3 +398,11 @@ fn rigid_platen_needs_a_one_sided_face() {
     .unwrap_err();
     assert_eq!(e.field.as_deref(), Some("prescribed[0].select"), "{e}");
 }
+
+#[test]
+fn line_search_is_a_named_choice() {
+    let s = with_sets(&["solver.line_search=\"l2\""]).unwrap();
+    assert_eq!(s.solver.line_search, LineSearch::L2);
+    let e = with_sets(&["solver.line_search=\"newton\""]).unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("solver.line_search"), "{e}");
+}
