@@ -5,11 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ranks=${1:-2}
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
-cargo build --release -q
-bin=$PWD/target/release/pfem-mpi
-work=target/bench/cantilever
-rm -rf "$work" && mkdir -p "$work" && cd "$work"
+source bench/setup.sh cantilever
 echo "| h (m) | steps | particles | u/L at λ=10 | err u | v/L at λ=10 | err v | err v at λ=5 | wall time (s) |"
 echo "|---|---|---|---|---|---|---|---|---|"
 for h in 0.25 0.125 0.1; do

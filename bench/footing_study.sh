@@ -6,11 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ranks=${1:-2}
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
-cargo build --release -q
-bin=$PWD/target/release/pfem-mpi
-work=target/bench/footing
-rm -rf "$work" && mkdir -p "$work" && cd "$work"
+source bench/setup.sh footing
 
 # mesh.h and the three fine spacings, finest at the footing edge.
 meshes=("4h 1.0 0.5 0.25 0.125" "2h 0.5 0.25 0.125 0.0625" "h 0.25 0.125 0.0625 0.03125")

@@ -4,11 +4,7 @@
 # (mesh.remap_all = true, as Abaqus' mesh-to-mesh mapping does). Usage: bench/mapping_cost.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-cargo build --release -q
-bin=$PWD/target/release/pfem-mpi
-work=target/bench/mapping
-rm -rf "$work" && mkdir -p "$work" && cd "$work"
+source bench/setup.sh mapping
 echo "| mapping | h (m) | u/L at λ=10 | v/L at λ=10 | v/L change |"
 echo "|---|---|---|---|---|"
 for h in 0.25 0.125; do

@@ -3,11 +3,7 @@
 # wall time, Newton iterations, tip deflection. Usage: bench/solvers.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
-cargo build --release -q
-bin=$PWD/target/release/pfem-mpi
-work=target/bench/solvers
-rm -rf "$work" && mkdir -p "$work" && cd "$work"
+source bench/setup.sh solvers
 "$bin" new cantilever -o c.h5 >/dev/null
 echo "| PETSc options | ranks | wall time (s) | Newton iterations | v/L at λ=10 |"
 echo "|---|---|---|---|---|"

@@ -1,0 +1,9 @@
+# Sourced by every bench script: `source bench/setup.sh NAME` from the repository root builds the
+# release binary, sets the MPI environment (root, oversubscription) and enters a fresh
+# target/bench/NAME; `$bin` is the binary.
+set -euo pipefail
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+cargo build --release -q
+bin=$PWD/target/release/pfem-mpi
+work=target/bench/$1
+rm -rf "$work" && mkdir -p "$work" && cd "$work"
