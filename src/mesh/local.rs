@@ -5,6 +5,7 @@
 
 use super::alpha::{alpha_keep, boundary_edges};
 use super::delaunay::delaunay;
+use super::near_ties::settle_near_ties;
 use std::collections::HashMap;
 
 /// Every kept triangle has circumradius R <= alpha*h and an owned vertex on its circumcircle, so its
@@ -54,8 +55,9 @@ impl LocalMesh {
         rank: i32,
         alpha: f64,
     ) -> Result<LocalMesh, MeshError> {
-        let all = delaunay(&points, &gids)
+        let mut all = delaunay(&points, &gids)
             .map_err(|e| MeshError(format!("Delaunay triangulation failed: {e}")))?;
+        settle_near_ties(&points, &gids, &mut all);
         let keep = alpha_keep(&points, &all, &h, alpha);
         let mut tris: Vec<[u32; 3]> = all
             .iter()

@@ -5,6 +5,7 @@ pub mod alpha;
 pub mod delaunay;
 pub mod fingerprint;
 pub mod local;
+pub mod near_ties;
 pub mod predicates;
 pub mod refine;
 

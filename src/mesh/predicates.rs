@@ -86,6 +86,12 @@ pub fn incircle_sos(p: [[f64; 2]; 4], ids: [u64; 4]) -> i32 {
     if det < 0.0 {
         return -1;
     }
+    sos_tie_sign(p, ids)
+}
+
+/// The sign [`incircle_sos`] gives four points as if they were exactly cocircular: the first
+/// non-zero lifted cofactor in decreasing-id order (`0` only if all four are collinear).
+pub fn sos_tie_sign(p: [[f64; 2]; 4], ids: [u64; 4]) -> i32 {
     let mut by_id = [0usize, 1, 2, 3];
     by_id.sort_unstable_by(|&i, &j| ids[j].cmp(&ids[i]));
     for i in by_id {
