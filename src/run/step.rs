@@ -401,6 +401,14 @@ impl Simulation {
                     cuts += 1;
                     piece *= 0.5;
                 }
+                Err(SolveError::Diverged(msg)) => {
+                    return Err(format!(
+                        "{msg}, on a piece of 1/{} of the step after {cuts} cuts (from load \
+                         factor {from:.6}); a smaller step (steps.count) or another line \
+                         search (solver.line_search) may get through",
+                        (full / (to - from)).round()
+                    ))
+                }
                 Err(e) => return Err(e.to_string()),
             }
         }
