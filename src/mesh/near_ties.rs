@@ -13,7 +13,7 @@
 //! that holds the quad: the mesh stays independent of the rank count.
 
 use super::predicates::{incircle, orient2d, sos_tie_sign};
-use std::collections::{BTreeSet, HashMap};
+use std::collections::BTreeSet;
 
 /// In-circle determinants within this fraction of their permanent (the sum of the absolute
 /// products, Shewchuk's error-bound scale) count as ties. Round-off in moved positions is about
@@ -56,45 +56,35 @@ pub fn incircle_near_sos(p: [[f64; 2]; 4], ids: [u64; 4]) -> i32 {
 /// [`incircle_near_sos`]. Edges are visited in global-id order. If the flips do not settle (a
 /// configuration where the near-tie rule is inconsistent), the exact triangulation is kept.
 pub fn settle_near_ties(points: &[[f64; 2]], ids: &[u64], tris: &mut Vec<[u32; 3]>) {
-    let original = tris.clone();
-    let mut across: HashMap<(u32, u32), usize> = HashMap::with_capacity(3 * tris.len());
-    for (t, tri) in tris.iter().enumerate() {
-        for k in 0..3 {
-            across.insert((tri[k], tri[(k + 1) % 3]), t);
-        }
-    }
-    let edge_key = |u: u32, v: u32| {
+    let mut nbr = neighbours(tris);
+    let edge = |t: usize, k: usize, tris: &[[u32; 3]]| {
+        let (u, v) = (tris[t][k], tris[t][(k + 1) % 3]);
         let (gu, gv) = (ids[u as usize], ids[v as usize]);
-        if gu < gv {
-            (gu, gv, u, v)
-        } else {
-            (gv, gu, v, u)
-        }
+        (gu.min(gv), gu.max(gv), t as u32, k as u8)
     };
-    let mut queue: BTreeSet<(u64, u64, u32, u32)> = BTreeSet::new();
-    for tri in tris.iter() {
+    // Only an edge whose quad is a near tie can be illegal: the rest are exact Delaunay edges.
+    let mut queue: BTreeSet<(u64, u64, u32, u8)> = BTreeSet::new();
+    for t in 0..tris.len() {
         for k in 0..3 {
-            queue.insert(edge_key(tri[k], tri[(k + 1) % 3]));
+            let o = nbr[t][k];
+            if o != NONE && (t as u32) < o && illegal(points, ids, tris, &nbr, t, k) {
+                queue.insert(edge(t, k, tris));
+            }
         }
     }
+    if queue.is_empty() {
+        return;
+    }
+    let original = tris.clone();
     let max_flips = 3 * tris.len() + 16;
     let mut flips = 0;
-    while let Some(e) = queue.pop_first() {
-        let (u, v) = (e.2, e.3);
-        // t1 holds u -> v, t2 holds v -> u; either orientation may be the stored one.
-        let (Some(&t1), Some(&t2)) = (across.get(&(u, v)), across.get(&(v, u))) else {
-            continue;
-        };
-        let c = third(tris[t1], u, v);
-        let d = third(tris[t2], v, u);
-        let quad = [u, v, c, d];
-        let pts = quad.map(|i| points[i as usize]);
-        if incircle_near_sos(pts, quad.map(|i| ids[i as usize])) <= 0 {
+    while let Some((g0, g1, t, k)) = queue.pop_first() {
+        let (t, k) = (t as usize, k as usize);
+        // Stale entry: the triangle was flipped since; its edges were queued again then.
+        if edge(t, k, tris).0 != g0 || edge(t, k, tris).1 != g1 || nbr[t][k] == NONE {
             continue;
         }
-        // u -> d -> v -> c is the quad counter-clockwise; the new diagonal is c-d.
-        let (pu, pv, pc, pd) = (pts[0], pts[1], pts[2], pts[3]);
-        if orient2d(pu, pd, pc) <= 0.0 || orient2d(pd, pv, pc) <= 0.0 {
+        if !illegal(points, ids, tris, &nbr, t, k) {
             continue;
         }
         flips += 1;
@@ -102,33 +92,87 @@ pub fn settle_near_ties(points: &[[f64; 2]], ids: &[u64], tris: &mut Vec<[u32; 3
             *tris = original;
             return;
         }
-        for (t, tri) in [(t1, tris[t1]), (t2, tris[t2])] {
-            for k in 0..3 {
-                if across.get(&(tri[k], tri[(k + 1) % 3])) == Some(&t) {
-                    across.remove(&(tri[k], tri[(k + 1) % 3]));
-                }
+        let (t1, t2) = flip(tris, &mut nbr, t, k);
+        for (t, k) in [(t1, 0), (t1, 2), (t2, 0), (t2, 1)] {
+            if nbr[t][k] != NONE {
+                queue.insert(edge(t, k, tris));
             }
-        }
-        tris[t1] = [u, d, c];
-        tris[t2] = [d, v, c];
-        for t in [t1, t2] {
-            let tri = tris[t];
-            for k in 0..3 {
-                across.insert((tri[k], tri[(k + 1) % 3]), t);
-            }
-        }
-        for (a, b) in [(u, d), (d, v), (v, c), (c, u)] {
-            queue.insert(edge_key(a, b));
         }
     }
 }
 
-/// The vertex of counter-clockwise `tri` opposite its directed edge `u -> v`.
-fn third(tri: [u32; 3], u: u32, v: u32) -> u32 {
-    let k = (0..3)
-        .find(|&k| tri[k] == u && tri[(k + 1) % 3] == v)
-        .unwrap_or(0);
-    tri[(k + 2) % 3]
+const NONE: u32 = u32::MAX;
+
+/// `nbr[t][k]`: the triangle across edge `tris[t][k] -> tris[t][k + 1]`, or `NONE` on the hull.
+fn neighbours(tris: &[[u32; 3]]) -> Vec<[u32; 3]> {
+    let mut half: Vec<(u64, u32)> = Vec::with_capacity(3 * tris.len());
+    for (t, tri) in tris.iter().enumerate() {
+        for k in 0..3 {
+            let (u, v) = (tri[k] as u64, tri[(k + 1) % 3] as u64);
+            half.push(((u.min(v) << 32) | u.max(v), (3 * t + k) as u32));
+        }
+    }
+    half.sort_unstable();
+    let mut nbr = vec![[NONE; 3]; tris.len()];
+    for w in half.windows(2) {
+        if w[0].0 == w[1].0 {
+            let (a, b) = (w[0].1 as usize, w[1].1 as usize);
+            nbr[a / 3][a % 3] = (b / 3) as u32;
+            nbr[b / 3][b % 3] = (a / 3) as u32;
+        }
+    }
+    nbr
+}
+
+/// The quad of edge k of triangle t: `[u, v, c, d]` with `t = (u, v, c)` and d across the edge.
+fn quad(tris: &[[u32; 3]], nbr: &[[u32; 3]], t: usize, k: usize) -> ([u32; 4], usize, usize) {
+    let (u, v, c) = (tris[t][k], tris[t][(k + 1) % 3], tris[t][(k + 2) % 3]);
+    let o = nbr[t][k] as usize;
+    let j = (0..3).find(|&j| tris[o][j] == v).unwrap_or(0);
+    ([u, v, c, tris[o][(j + 2) % 3]], o, j)
+}
+
+/// Whether edge k of triangle t fails the near-tie in-circle test and its quad can be flipped.
+fn illegal(
+    points: &[[f64; 2]],
+    ids: &[u64],
+    tris: &[[u32; 3]],
+    nbr: &[[u32; 3]],
+    t: usize,
+    k: usize,
+) -> bool {
+    let (q, _, _) = quad(tris, nbr, t, k);
+    let p = q.map(|i| points[i as usize]);
+    if incircle_near_sos(p, q.map(|i| ids[i as usize])) <= 0 {
+        return false;
+    }
+    // u -> d -> v -> c is the quad counter-clockwise; the new diagonal c-d needs it convex.
+    orient2d(p[0], p[3], p[2]) > 0.0 && orient2d(p[3], p[1], p[2]) > 0.0
+}
+
+/// Replaces edge u-v of t = (u, v, c) and its neighbour (v, u, d) by c-d: t becomes (u, d, c)
+/// and the neighbour (d, v, c). Returns the two triangles' indices.
+fn flip(tris: &mut [[u32; 3]], nbr: &mut [[u32; 3]], t: usize, k: usize) -> (usize, usize) {
+    let ([u, v, c, d], o, j) = quad(tris, nbr, t, k);
+    let n_ud = nbr[o][(j + 1) % 3];
+    let n_dv = nbr[o][(j + 2) % 3];
+    let n_vc = nbr[t][(k + 1) % 3];
+    let n_cu = nbr[t][(k + 2) % 3];
+    tris[t] = [u, d, c];
+    nbr[t] = [n_ud, o as u32, n_cu];
+    tris[o] = [d, v, c];
+    nbr[o] = [n_dv, n_vc, t as u32];
+    // The triangles across u-d and v-c now face the other of the pair.
+    for (n, from, to) in [(n_ud, o, t), (n_vc, t, o)] {
+        if n != NONE {
+            for slot in nbr[n as usize].iter_mut() {
+                if *slot == from as u32 {
+                    *slot = to as u32;
+                }
+            }
+        }
+    }
+    (t, o)
 }
 
 #[cfg(test)]
@@ -143,7 +187,9 @@ mod tests {
                 pts.push(map([i as f64 * 0.05, j as f64 * 0.05]));
             }
         }
-        let ids = (0..pts.len() as u64).map(|i| (i * 7919) % 10007).collect();
+        let ids = (0..pts.len() as u64)
+            .map(|i| (i * 7919) % 1_000_003)
+            .collect();
         (pts, ids)
     }
 
@@ -189,6 +235,72 @@ mod tests {
             "the noise flips many cells: {}",
             missing(&exact)
         );
+    }
+
+    /// A rank meshes a window of the cloud (owned particles plus halo): the settled triangles well
+    /// inside the window are the settled triangles of the whole cloud.
+    #[test]
+    fn a_window_settles_like_the_whole_cloud() {
+        let mut state = 11u64;
+        let (p, ids) = lattice(31, |p| {
+            let noise = (crate::rng::next(&mut state) % 1000) as f64 * 1e-15 - 5e-13;
+            [p[0] * 1.3 + noise, p[1] * 0.77 + noise]
+        });
+        let mut whole = delaunay(&p, &ids).unwrap();
+        settle_near_ties(&p, &ids, &mut whole);
+        let key = |t: &[u32; 3], idx: &[usize]| {
+            let mut k = t.map(|v| ids[idx[v as usize]]);
+            k.sort();
+            k
+        };
+        let all: Vec<usize> = (0..p.len()).collect();
+        let global: std::collections::HashSet<[u64; 3]> =
+            whole.iter().map(|t| key(t, &all)).collect();
+        let inside = |q: [f64; 2], m: f64| {
+            q[0] > 0.3 + m && q[0] < 1.2 - m && q[1] > 0.2 + m && q[1] < 0.8 - m
+        };
+        let window: Vec<usize> = (0..p.len()).filter(|&i| inside(p[i], 0.0)).collect();
+        let wp: Vec<[f64; 2]> = window.iter().map(|&i| p[i]).collect();
+        let wid: Vec<u64> = window.iter().map(|&i| ids[i]).collect();
+        let mut local = delaunay(&wp, &wid).unwrap();
+        settle_near_ties(&wp, &wid, &mut local);
+        let mut checked = 0;
+        for t in &local {
+            if t.iter().all(|&v| inside(wp[v as usize], 0.1)) {
+                assert!(global.contains(&key(t, &window)), "triangle {t:?} differs");
+                checked += 1;
+            }
+        }
+        assert!(checked > 100, "checked {checked}");
+    }
+
+    /// Timing, not a check: `cargo test --release --lib meshing_timing -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn meshing_timing() {
+        let mut state = 5u64;
+        let mut unit = || (crate::rng::next(&mut state) >> 11) as f64 / (1u64 << 53) as f64;
+        let random: Vec<[f64; 2]> = (0..100_000).map(|_| [unit(), unit()]).collect();
+        let (lat, lat_ids) = lattice(316, |p| p);
+        for (name, p, ids) in [
+            (
+                "100 k random",
+                random,
+                (0..100_000u64).collect::<Vec<u64>>(),
+            ),
+            ("316 x 316 lattice", lat, lat_ids),
+        ] {
+            let t0 = std::time::Instant::now();
+            let mut tris = delaunay(&p, &ids).unwrap();
+            let t1 = std::time::Instant::now();
+            settle_near_ties(&p, &ids, &mut tris);
+            let t2 = std::time::Instant::now();
+            println!(
+                "{name}: Delaunay {:.3} s, near-tie pass {:.3} s",
+                (t1 - t0).as_secs_f64(),
+                (t2 - t1).as_secs_f64()
+            );
+        }
     }
 
     /// A jittered cloud has no near ties: its Delaunay triangulation is left alone.
