@@ -12,18 +12,18 @@
 //! Decisions read only the quad's four points and ids, so the result is the same on every rank
 //! that holds the quad: the mesh stays independent of the rank count.
 
-use super::predicates::{incircle, orient2d, sos_tie_sign};
+use super::predicates::{orient2d, sos_tie_sign};
 use std::collections::BTreeSet;
 
 /// In-circle determinants within this fraction of their permanent (the sum of the absolute
 /// products, Shewchuk's error-bound scale) count as ties. Round-off in moved positions is about
 /// 1e-11 of the spacing; any physical departure from a rectangle this small is immaterial to
 /// which diagonal the cell gets.
-pub const TIE_TOLERANCE: f64 = 1e-8;
+const TIE_TOLERANCE: f64 = 1e-8;
 
 /// The in-circle sign with near ties broken as exact ones: `+1` if `d` counts as inside the circle
 /// through counter-clockwise `a, b, c`.
-pub fn incircle_near_sos(p: [[f64; 2]; 4], ids: [u64; 4]) -> i32 {
+fn incircle_near_sos(p: [[f64; 2]; 4], ids: [u64; 4]) -> i32 {
     let [a, b, c, d] = p;
     let (adx, ady) = (a[0] - d[0], a[1] - d[1]);
     let (bdx, bdy) = (b[0] - d[0], b[1] - d[1]);
@@ -38,16 +38,14 @@ pub fn incircle_near_sos(p: [[f64; 2]; 4], ids: [u64; 4]) -> i32 {
     let permanent = al * ((bdx * cdy).abs() + (cdx * bdy).abs())
         + bl * ((cdx * ady).abs() + (adx * cdy).abs())
         + cl * ((adx * bdy).abs() + (bdx * ady).abs());
+    // Beyond the tolerance the floating-point sign is the exact one: its error bound is about
+    // 1e-15 of the permanent.
     if det.abs() <= TIE_TOLERANCE * permanent {
-        return sos_tie_sign(p, ids);
-    }
-    let exact = incircle(a, b, c, d);
-    if exact > 0.0 {
-        1
-    } else if exact < 0.0 {
-        -1
-    } else {
         sos_tie_sign(p, ids)
+    } else if det > 0.0 {
+        1
+    } else {
+        -1
     }
 }
 
