@@ -153,7 +153,17 @@ mod tests {
         }
         let np = pts.len();
         let build = |gids: Vec<u64>| {
-            LocalMesh::build(pts.clone(), gids, vec![0; np], vec![h; np], np, 0, 1.3).unwrap()
+            LocalMesh::build(
+                pts.clone(),
+                gids,
+                vec![0; np],
+                vec![h; np],
+                np,
+                0,
+                1.3,
+                true,
+            )
+            .unwrap()
         };
         (
             build((0..np as u64).collect()),

@@ -33,6 +33,10 @@ pub struct LocalMesh {
     pub on_boundary: Vec<bool>,
     /// Boundary edges touching an owned particle (body on the left).
     pub boundary_edges: Vec<[u32; 2]>,
+    /// False if the near-tie pass was asked for but did not settle here, so this rank kept the
+    /// exact Delaunay triangulation: then every rank must rebuild without the pass, or the ranks'
+    /// meshes may disagree.
+    pub ties_settled: bool,
 }
 
 #[derive(Debug)]
@@ -45,7 +49,9 @@ impl std::fmt::Display for MeshError {
 }
 
 impl LocalMesh {
-    /// Builds the rank-local mesh. `h` is the local spacing per point (same order as `points`).
+    /// Builds the rank-local mesh. `h` is the local spacing per point (same order as `points`);
+    /// `near_ties` asks for the near-tie pass (`super::near_ties`) after the Delaunay.
+    #[allow(clippy::too_many_arguments)]
     pub fn build(
         points: Vec<[f64; 2]>,
         gids: Vec<u64>,
@@ -54,10 +60,11 @@ impl LocalMesh {
         n_owned: usize,
         rank: i32,
         alpha: f64,
+        near_ties: bool,
     ) -> Result<LocalMesh, MeshError> {
         let mut all = delaunay(&points, &gids)
             .map_err(|e| MeshError(format!("Delaunay triangulation failed: {e}")))?;
-        settle_near_ties(&points, &gids, &mut all);
+        let ties_settled = !near_ties || settle_near_ties(&points, &gids, &mut all);
         let keep = alpha_keep(&points, &all, &h, alpha);
         let mut tris: Vec<[u32; 3]> = all
             .iter()
@@ -89,6 +96,7 @@ impl LocalMesh {
             tri_owned,
             on_boundary,
             boundary_edges: bedges,
+            ties_settled,
         })
     }
 

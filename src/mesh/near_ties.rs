@@ -22,8 +22,26 @@ use std::collections::BTreeSet;
 const TIE_TOLERANCE: f64 = 1e-8;
 
 /// The in-circle sign with near ties broken as exact ones: `+1` if `d` counts as inside the circle
-/// through counter-clockwise `a, b, c`.
+/// through counter-clockwise `a, b, c`. Whether the quad is a near tie is decided on the four
+/// points taken in global-id order (the permanent depends on the reference corner), so both
+/// diagonals of a quad, tested from either side, get one consistent answer.
 fn incircle_near_sos(p: [[f64; 2]; 4], ids: [u64; 4]) -> i32 {
+    let mut order = [0usize, 1, 2, 3];
+    order.sort_unstable_by_key(|&i| ids[i]);
+    let (det, permanent) = incircle_float(order.map(|i| p[i]));
+    // Beyond the tolerance the floating-point sign is the exact one: its error bound is about
+    // 1e-15 of the permanent.
+    if det.abs() <= TIE_TOLERANCE * permanent {
+        sos_tie_sign(p, ids)
+    } else {
+        // The determinant is alternating: reordering the points multiplies it by the parity.
+        let sign = if det > 0.0 { 1 } else { -1 };
+        sign * parity(order)
+    }
+}
+
+/// The in-circle determinant of `p` in floating point, and its permanent.
+fn incircle_float(p: [[f64; 2]; 4]) -> (f64, f64) {
     let [a, b, c, d] = p;
     let (adx, ady) = (a[0] - d[0], a[1] - d[1]);
     let (bdx, bdy) = (b[0] - d[0], b[1] - d[1]);
@@ -38,11 +56,20 @@ fn incircle_near_sos(p: [[f64; 2]; 4], ids: [u64; 4]) -> i32 {
     let permanent = al * ((bdx * cdy).abs() + (cdx * bdy).abs())
         + bl * ((cdx * ady).abs() + (adx * cdy).abs())
         + cl * ((adx * bdy).abs() + (bdx * ady).abs());
-    // Beyond the tolerance the floating-point sign is the exact one: its error bound is about
-    // 1e-15 of the permanent.
-    if det.abs() <= TIE_TOLERANCE * permanent {
-        sos_tie_sign(p, ids)
-    } else if det > 0.0 {
+    (det, permanent)
+}
+
+/// +1 for an even permutation, -1 for an odd one.
+fn parity(order: [usize; 4]) -> i32 {
+    let mut inversions = 0;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            if order[i] > order[j] {
+                inversions += 1;
+            }
+        }
+    }
+    if inversions % 2 == 0 {
         1
     } else {
         -1
@@ -51,9 +78,11 @@ fn incircle_near_sos(p: [[f64; 2]; 4], ids: [u64; 4]) -> i32 {
 
 /// Flips the diagonals of near-cocircular convex quads of the Delaunay triangulation `tris`
 /// (counter-clockwise, local indices into `points`) until every edge is legal under
-/// [`incircle_near_sos`]. Edges are visited in global-id order. If the flips do not settle (a
-/// configuration where the near-tie rule is inconsistent), the exact triangulation is kept.
-pub fn settle_near_ties(points: &[[f64; 2]], ids: &[u64], tris: &mut Vec<[u32; 3]>) {
+/// [`incircle_near_sos`]. Edges are visited in global-id order (the two sides of one edge give
+/// the same answer), so the flips do not depend on local indices. Returns `false`, with the exact
+/// triangulation restored, if the flips do not settle (a cluster where the near-tie rule is
+/// inconsistent); the caller must then keep the exact triangulation on every rank.
+pub fn settle_near_ties(points: &[[f64; 2]], ids: &[u64], tris: &mut Vec<[u32; 3]>) -> bool {
     let mut nbr = neighbours(tris);
     let edge = |t: usize, k: usize, tris: &[[u32; 3]]| {
         let (u, v) = (tris[t][k], tris[t][(k + 1) % 3]);
@@ -71,7 +100,7 @@ pub fn settle_near_ties(points: &[[f64; 2]], ids: &[u64], tris: &mut Vec<[u32; 3
         }
     }
     if queue.is_empty() {
-        return;
+        return true;
     }
     let original = tris.clone();
     let max_flips = 3 * tris.len() + 16;
@@ -88,7 +117,7 @@ pub fn settle_near_ties(points: &[[f64; 2]], ids: &[u64], tris: &mut Vec<[u32; 3
         flips += 1;
         if flips > max_flips {
             *tris = original;
-            return;
+            return false;
         }
         let (t1, t2) = flip(tris, &mut nbr, t, k);
         for (t, k) in [(t1, 0), (t1, 2), (t2, 0), (t2, 1)] {
@@ -97,6 +126,7 @@ pub fn settle_near_ties(points: &[[f64; 2]], ids: &[u64], tris: &mut Vec<[u32; 3
             }
         }
     }
+    true
 }
 
 const NONE: u32 = u32::MAX;
@@ -126,7 +156,12 @@ fn neighbours(tris: &[[u32; 3]]) -> Vec<[u32; 3]> {
 fn quad(tris: &[[u32; 3]], nbr: &[[u32; 3]], t: usize, k: usize) -> ([u32; 4], usize, usize) {
     let (u, v, c) = (tris[t][k], tris[t][(k + 1) % 3], tris[t][(k + 2) % 3]);
     let o = nbr[t][k] as usize;
-    let j = (0..3).find(|&j| tris[o][j] == v).unwrap_or(0);
+    let j = (0..3).find(|&j| tris[o][j] == v);
+    debug_assert!(
+        j.is_some(),
+        "neighbour {o} of triangle {t} lacks vertex {v}"
+    );
+    let j = j.unwrap_or(0);
     ([u, v, c, tris[o][(j + 2) % 3]], o, j)
 }
 
@@ -203,13 +238,90 @@ mod tests {
         v
     }
 
+    /// Every triangle counter-clockwise, every interior edge shared by exactly two of them, the
+    /// same area as the exact triangulation, and no edge illegal from either side.
+    fn check_settled(points: &[[f64; 2]], ids: &[u64], tris: &[[u32; 3]], exact: &[[u32; 3]]) {
+        let area = |ts: &[[u32; 3]]| -> f64 {
+            ts.iter()
+                .map(|t| {
+                    orient2d(
+                        points[t[0] as usize],
+                        points[t[1] as usize],
+                        points[t[2] as usize],
+                    )
+                })
+                .sum()
+        };
+        for t in tris {
+            assert!(
+                orient2d(
+                    points[t[0] as usize],
+                    points[t[1] as usize],
+                    points[t[2] as usize]
+                ) > 0.0
+            );
+        }
+        assert!((area(tris) - area(exact)).abs() <= 1e-12 * area(exact));
+        let nbr = neighbours(tris);
+        let mut directed = std::collections::HashSet::new();
+        for (t, tri) in tris.iter().enumerate() {
+            for k in 0..3 {
+                assert!(
+                    directed.insert((tri[k], tri[(k + 1) % 3])),
+                    "edge used twice"
+                );
+                if nbr[t][k] != NONE {
+                    assert!(!illegal(points, ids, tris, &nbr, t, k), "illegal edge left");
+                }
+            }
+        }
+    }
+
+    /// A ring of near-cocircular points inside a second ring: every quad of the inner ring is a
+    /// near tie, so the noisy exact triangulation needs cascading flips, and the result must be
+    /// the one the noise-free ring gets (whose cos/sin round-off is itself a near tie).
+    #[test]
+    fn a_noisy_ring_settles_to_the_clean_ring() {
+        let n = 16;
+        let mut state = 9u64;
+        let ring = |noise: f64, state: &mut u64| -> Vec<[f64; 2]> {
+            let mut pts = Vec::new();
+            for (r, turn) in [(1.0, 0.0), (2.0, 0.5)] {
+                for i in 0..n {
+                    let a = (i as f64 + turn) * std::f64::consts::TAU / n as f64;
+                    let e = ((crate::rng::next(state) % 2001) as f64 - 1000.0) * noise;
+                    let rr = if r == 1.0 { r * (1.0 + e) } else { r };
+                    pts.push([0.3 + rr * a.cos(), -0.2 + rr * a.sin()]);
+                }
+            }
+            pts
+        };
+        let ids: Vec<u64> = (0..2 * n as u64).map(|i| (i * 7919) % 1_000_003).collect();
+        let clean = ring(0.0, &mut state);
+        let noisy = ring(1e-13, &mut state);
+        let mut settled_clean = delaunay(&clean, &ids).unwrap();
+        let exact_clean = settled_clean.clone();
+        assert!(settle_near_ties(&clean, &ids, &mut settled_clean));
+        check_settled(&clean, &ids, &settled_clean, &exact_clean);
+        let exact = delaunay(&noisy, &ids).unwrap();
+        let mut settled = exact.clone();
+        assert!(settle_near_ties(&noisy, &ids, &mut settled));
+        check_settled(&noisy, &ids, &settled, &exact);
+        assert_eq!(sorted(&settled), sorted(&settled_clean));
+        assert_ne!(
+            sorted(&exact),
+            sorted(&settled),
+            "the noise should need flips"
+        );
+    }
+
     /// A stretched lattice with round-off noise in its positions gets the undeformed lattice's
     /// triangles back; without the near-tie rule the noise flips many of its diagonals.
     #[test]
     fn a_noisy_stretched_lattice_keeps_the_lattice_mesh() {
         let (p0, ids) = lattice(21, |p| p);
         let mut reference = delaunay(&p0, &ids).unwrap();
-        settle_near_ties(&p0, &ids, &mut reference);
+        assert!(settle_near_ties(&p0, &ids, &mut reference));
         let mut state = 7u64;
         let (p1, _) = lattice(21, |p| {
             let noise = (crate::rng::next(&mut state) % 1000) as f64 * 1e-15 - 5e-13;
@@ -217,7 +329,8 @@ mod tests {
         });
         let exact = delaunay(&p1, &ids).unwrap();
         let mut settled = exact.clone();
-        settle_near_ties(&p1, &ids, &mut settled);
+        assert!(settle_near_ties(&p1, &ids, &mut settled));
+        check_settled(&p1, &ids, &settled, &exact);
         // The noisy hull gains slivers (the alpha shape drops them); every lattice triangle
         // must be back.
         let (settled, exact) = (sorted(&settled), sorted(&exact));
@@ -260,8 +373,15 @@ mod tests {
         let window: Vec<usize> = (0..p.len()).filter(|&i| inside(p[i], 0.0)).collect();
         let wp: Vec<[f64; 2]> = window.iter().map(|&i| p[i]).collect();
         let wid: Vec<u64> = window.iter().map(|&i| ids[i]).collect();
-        let mut local = delaunay(&wp, &wid).unwrap();
-        settle_near_ties(&wp, &wid, &mut local);
+        let exact = delaunay(&wp, &wid).unwrap();
+        let mut local = exact.clone();
+        assert!(settle_near_ties(&wp, &wid, &mut local));
+        check_settled(&wp, &wid, &local, &exact);
+        assert_ne!(
+            sorted(&local),
+            sorted(&exact),
+            "the noise should need flips"
+        );
         let mut checked = 0;
         for t in &local {
             if t.iter().all(|&v| inside(wp[v as usize], 0.1)) {
@@ -291,7 +411,7 @@ mod tests {
             let t0 = std::time::Instant::now();
             let mut tris = delaunay(&p, &ids).unwrap();
             let t1 = std::time::Instant::now();
-            settle_near_ties(&p, &ids, &mut tris);
+            assert!(settle_near_ties(&p, &ids, &mut tris));
             let t2 = std::time::Instant::now();
             println!(
                 "{name}: Delaunay {:.3} s, near-tie pass {:.3} s",
@@ -311,7 +431,7 @@ mod tests {
         });
         let exact = delaunay(&p, &ids).unwrap();
         let mut settled = exact.clone();
-        settle_near_ties(&p, &ids, &mut settled);
+        assert!(settle_near_ties(&p, &ids, &mut settled));
         assert_eq!(settled, exact);
     }
 }

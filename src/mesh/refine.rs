@@ -160,7 +160,7 @@ mod tests {
         }
         let n = pts.len();
         let gids = (0..n as u64).collect();
-        LocalMesh::build(pts, gids, vec![0; n], vec![h; n], n, 0, 1.3).unwrap()
+        LocalMesh::build(pts, gids, vec![0; n], vec![h; n], n, 0, 1.3, true).unwrap()
     }
 
     #[test]

@@ -136,16 +136,21 @@ impl Simulation {
             .chain(g.owner.iter().copied())
             .collect();
         let h: Vec<f64> = p.h.iter().chain(&g.h).copied().collect();
-        LocalMesh::build(
-            points,
-            gids,
-            owner,
-            h,
-            p.len(),
-            rank,
-            self.model.scene.mesh.alpha,
-        )
-        .map_err(err)
+        let alpha = self.model.scene.mesh.alpha;
+        let n = p.len();
+        let mesh = LocalMesh::build(points, gids, owner, h, n, rank, alpha, true).map_err(err)?;
+        // One rank's unsettled near ties put every rank back on the exact Delaunay mesh.
+        if max_f64(world, if mesh.ties_settled { 0.0 } else { 1.0 }) > 0.0 {
+            let LocalMesh {
+                points,
+                gids,
+                owner,
+                h,
+                ..
+            } = mesh;
+            return LocalMesh::build(points, gids, owner, h, n, rank, alpha, false).map_err(err);
+        }
+        Ok(mesh)
     }
 
     /// Start-of-step Gauss states on the new mesh (rank-local).
