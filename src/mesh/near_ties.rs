@@ -83,6 +83,11 @@ fn parity(order: [usize; 4]) -> i32 {
 /// triangulation restored, if the flips do not settle (a cluster where the near-tie rule is
 /// inconsistent); the caller must then keep the exact triangulation on every rank.
 pub fn settle_near_ties(points: &[[f64; 2]], ids: &[u64], tris: &mut Vec<[u32; 3]>) -> bool {
+    settle(points, ids, tris).is_some()
+}
+
+/// [`settle_near_ties`], returning the neighbour array it kept up to date (`None` if unsettled).
+fn settle(points: &[[f64; 2]], ids: &[u64], tris: &mut Vec<[u32; 3]>) -> Option<Vec<[u32; 3]>> {
     let mut nbr = neighbours(tris);
     let edge = |t: usize, k: usize, tris: &[[u32; 3]]| {
         let (u, v) = (tris[t][k], tris[t][(k + 1) % 3]);
@@ -100,7 +105,7 @@ pub fn settle_near_ties(points: &[[f64; 2]], ids: &[u64], tris: &mut Vec<[u32; 3
         }
     }
     if queue.is_empty() {
-        return true;
+        return Some(nbr);
     }
     let original = tris.clone();
     let max_flips = 3 * tris.len() + 16;
@@ -117,7 +122,7 @@ pub fn settle_near_ties(points: &[[f64; 2]], ids: &[u64], tris: &mut Vec<[u32; 3
         flips += 1;
         if flips > max_flips {
             *tris = original;
-            return false;
+            return None;
         }
         let (t1, t2) = flip(tris, &mut nbr, t, k);
         for (t, k) in [(t1, 0), (t1, 2), (t2, 0), (t2, 1)] {
@@ -126,7 +131,7 @@ pub fn settle_near_ties(points: &[[f64; 2]], ids: &[u64], tris: &mut Vec<[u32; 3
             }
         }
     }
-    true
+    Some(nbr)
 }
 
 const NONE: u32 = u32::MAX;
@@ -238,9 +243,18 @@ mod tests {
         v
     }
 
-    /// Every triangle counter-clockwise, every interior edge shared by exactly two of them, the
-    /// same area as the exact triangulation, and no edge illegal from either side.
-    fn check_settled(points: &[[f64; 2]], ids: &[u64], tris: &[[u32; 3]], exact: &[[u32; 3]]) {
+    /// Settled, with the neighbour array the flips kept equal to one built afresh; every triangle
+    /// counter-clockwise, every directed edge used once, the same area as the exact
+    /// triangulation, and no edge illegal from either side.
+    fn check_settled(
+        points: &[[f64; 2]],
+        ids: &[u64],
+        tris: &[[u32; 3]],
+        exact: &[[u32; 3]],
+        kept: Option<Vec<[u32; 3]>>,
+    ) {
+        let kept = kept.expect("the flips should settle");
+        assert_eq!(kept, neighbours(tris), "neighbour array out of date");
         let area = |ts: &[[u32; 3]]| -> f64 {
             ts.iter()
                 .map(|t| {
@@ -301,12 +315,12 @@ mod tests {
         let noisy = ring(1e-13, &mut state);
         let mut settled_clean = delaunay(&clean, &ids).unwrap();
         let exact_clean = settled_clean.clone();
-        assert!(settle_near_ties(&clean, &ids, &mut settled_clean));
-        check_settled(&clean, &ids, &settled_clean, &exact_clean);
+        let kept = settle(&clean, &ids, &mut settled_clean);
+        check_settled(&clean, &ids, &settled_clean, &exact_clean, kept);
         let exact = delaunay(&noisy, &ids).unwrap();
         let mut settled = exact.clone();
-        assert!(settle_near_ties(&noisy, &ids, &mut settled));
-        check_settled(&noisy, &ids, &settled, &exact);
+        let kept = settle(&noisy, &ids, &mut settled);
+        check_settled(&noisy, &ids, &settled, &exact, kept);
         assert_eq!(sorted(&settled), sorted(&settled_clean));
         assert_ne!(
             sorted(&exact),
@@ -329,8 +343,8 @@ mod tests {
         });
         let exact = delaunay(&p1, &ids).unwrap();
         let mut settled = exact.clone();
-        assert!(settle_near_ties(&p1, &ids, &mut settled));
-        check_settled(&p1, &ids, &settled, &exact);
+        let kept = settle(&p1, &ids, &mut settled);
+        check_settled(&p1, &ids, &settled, &exact, kept);
         // The noisy hull gains slivers (the alpha shape drops them); every lattice triangle
         // must be back.
         let (settled, exact) = (sorted(&settled), sorted(&exact));
@@ -375,8 +389,8 @@ mod tests {
         let wid: Vec<u64> = window.iter().map(|&i| ids[i]).collect();
         let exact = delaunay(&wp, &wid).unwrap();
         let mut local = exact.clone();
-        assert!(settle_near_ties(&wp, &wid, &mut local));
-        check_settled(&wp, &wid, &local, &exact);
+        let kept = settle(&wp, &wid, &mut local);
+        check_settled(&wp, &wid, &local, &exact, kept);
         assert_ne!(
             sorted(&local),
             sorted(&exact),
