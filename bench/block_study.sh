@@ -21,12 +21,12 @@ for cloud in "h=0.1 lattice|mesh.h=0.1" "h=0.1 jittered 0.3|body.jitter=0.3" "h=
     status=ok
     mpirun -n "$ranks" "$bin" "$name.h5" --out "$run.out" >"$run.log" 2>&1 || status=failed
     t1=$(date +%s.%N)
-    reached=$(tail -1 "$run.out/history.csv" | cut -d, -f2)
+    reached=$(tail -1 "$run.out/history.csv" 2>/dev/null | cut -d, -f2 || true)
     if [[ $status == failed ]]; then
-      reached="$reached (then $(grep -m1 -o 'Newton did not converge ([A-Z_]*)' "$run.log"))"
+      reached="$reached (then $(grep -m1 -o -e 'Newton did not converge ([A-Z_]*)' -e 'Newton stalled' "$run.log" || true))"
     fi
     its=$(grep -o '[0-9]* Newton iterations' "$run.log" | cut -d' ' -f1 || true)
-    n=$(grep '^step' "$run.log" | tail -1 | grep -o 'particles [0-9]*' | cut -d' ' -f2)
+    n=$(grep '^step' "$run.log" | tail -1 | grep -o 'particles [0-9]*' | cut -d' ' -f2 || true)
     # From step 2 on the block is yielded (step 1 ends at 0.5 % strain, partly elastic).
     awk -F, -v c="$label" -v r="$ranks" -v reached="$reached" -v n="$n" -v its="${its:--}" \
       -v t="$(echo "$t1 - $t0" | bc)" '
@@ -39,6 +39,6 @@ for cloud in "h=0.1 lattice|mesh.h=0.1" "h=0.1 jittered 0.3|body.jitter=0.3" "h=
       END {
         printf "| %s | %d | %s | %+.2e | %s | %s | %+.2e | %s | %s | %.1f |\n", c, r, reached, signed,
           at, (onset == "" ? "never" : onset), vw, n, its, t
-      }' "$run.out/history.csv"
+      }' "$run.out/history.csv" 2>/dev/null || echo "| $label | $ranks | failed before step 1 | | | | | | | |"
   done
 done
