@@ -71,6 +71,8 @@ impl TriStates {
 pub struct MapStats {
     pub kept: usize,
     pub interpolated: usize,
+    /// Interpolated triangles this rank owns (a sum over ranks counts each triangle once).
+    pub interpolated_owned: usize,
 }
 
 /// States for `mesh`'s triangles: kept where the triangle existed before (same three global
@@ -92,6 +94,7 @@ pub fn map_states(
                 return *s;
             }
             stats.interpolated += 1;
+            stats.interpolated_owned += usize::from(mesh.tri_owned[t]);
             let tri = mesh.tris[t];
             let v = tri.map(|i| mesh.points[i as usize]);
             let vals = tri.map(|i| at_points[i as usize]);

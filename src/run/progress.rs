@@ -59,7 +59,7 @@ impl Progress {
         let left =
             (self.total - step) as f64 * self.started.elapsed().as_secs_f64() / done.max(1.0);
         println!(
-            "step {step:>5}/{} load {:.4} newton {:>2}{} |R| {:.2e} particles {} triangles {} | {} | step {:.3}s left {:.0}s",
+            "step {step:>5}/{} load {:.4} newton {:>2}{} |R| {:.2e} particles {} triangles {} remapped {} | {} | step {:.3}s left {:.0}s",
             self.total,
             sim.load_factor(),
             r.newton_iterations,
@@ -67,6 +67,7 @@ impl Progress {
             r.residual_norm,
             r.particles,
             r.triangles,
+            r.remapped,
             phases.join(" "),
             t.total(),
             left

@@ -30,6 +30,8 @@ pub struct Simulation {
     /// The last increment's nodal solution by global node ([gid, gid] for a vertex, the sorted
     /// end ids for a midside node): displacement per whole step and pressure. The next predictor.
     pub(super) last_nodes: std::cell::RefCell<std::collections::HashMap<[u64; 2], [f64; 3]>>,
+    /// Owned triangles interpolated by `map` since the last step report.
+    pub(super) remapped: std::cell::Cell<u64>,
     first_step: u64,
 }
 
@@ -39,6 +41,8 @@ pub struct StepReport {
     /// Times the step's increment was halved after a Newton divergence.
     pub cuts: usize,
     pub residual_norm: f64,
+    /// Triangles whose Gauss states were interpolated (new since the last mesh), all ranks.
+    pub remapped: u64,
     pub particles: u64,
     pub triangles: u64,
 }
@@ -81,6 +85,7 @@ impl Simulation {
             last_area: 0.0,
             solver: Default::default(),
             last_nodes: Default::default(),
+            remapped: Default::default(),
         };
         if world.size() > 1 && !same_partition {
             sim.repartition(world)?;
@@ -168,7 +173,10 @@ impl Simulation {
         } else {
             &self.tri_states
         };
-        map_states(old, mesh, &at_points).0
+        let (states, stats) = map_states(old, mesh, &at_points);
+        self.remapped
+            .set(self.remapped.get() + stats.interpolated_owned as u64);
+        states
     }
 
     pub(super) fn reference_position(&self, mesh: &LocalMesh, p: usize) -> [f64; 2] {

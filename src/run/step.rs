@@ -344,7 +344,11 @@ impl Simulation {
         }
         let counts = sum_f64(
             world,
-            &[self.particles.len() as f64, mesh.n_owned_tris() as f64],
+            &[
+                self.particles.len() as f64,
+                mesh.n_owned_tris() as f64,
+                self.remapped.take() as f64,
+            ],
         );
         Ok(StepReport {
             newton_iterations: solved.newton_iterations,
@@ -352,6 +356,7 @@ impl Simulation {
             residual_norm: solved.residual_norm,
             particles: counts[0] as u64,
             triangles: counts[1] as u64,
+            remapped: counts[2] as u64,
         })
     }
 }
@@ -375,7 +380,7 @@ impl Simulation {
         let mut from = self.header.load_factor;
         let mut piece = full;
         let mut states = states;
-        let (mut cuts, mut newton) = (0, 0);
+        let (mut cuts, mut newton, mut remapped) = (0, 0, 0);
         loop {
             let to = if from + piece >= target - 1e-9 * full {
                 target
@@ -387,8 +392,10 @@ impl Simulation {
                     let completes = to == target;
                     let mut report = self.update(world, mesh, solved, completes)?;
                     newton += report.newton_iterations;
+                    remapped += report.remapped;
                     if completes {
                         report.newton_iterations = newton;
+                        report.remapped = remapped;
                         report.cuts = cuts;
                         return Ok(report);
                     }
