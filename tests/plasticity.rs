@@ -36,13 +36,13 @@ fn block_compression_holds_two_cu_and_the_volume() {
             worst_volume = worst_volume.max((r[3] - 1.0).abs());
         }
         println!("{ranks} ranks: stress/cu off 2 by at most {worst_stress:.2e} (relative), volume by {worst_volume:.2e}");
+        // The issue asks for 1 %. The homogeneous flow on this lattice keeps its mesh except where
+        // refinement splits it, so 2·cu holds to round-off (measured 1e-12); bands would show far
+        // above 1e-6.
         assert!(
-            worst_stress < 0.01,
-            "stress/cu must stay within 1 % of 2 once yielded"
+            worst_stress < 1e-6,
+            "stress/cu off 2 by {worst_stress:e} once yielded"
         );
-        // The homogeneous flow on this lattice keeps its mesh except where refinement splits it,
-        // so 2·cu holds to round-off (measured 1e-12); bands would show far above 1e-6.
-        assert!(worst_stress < 1e-6, "stress/cu off 2 by {worst_stress:e}");
         assert!(
             worst_volume < 0.005,
             "volume must change by less than 0.5 %"
