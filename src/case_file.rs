@@ -52,7 +52,7 @@ use mpi::traits::*;
 
 pub use collective::block_range;
 pub use error::{CaseError, CaseErrorKind};
-pub use gauss::{GaussRecords, GAUSS_LEN, NODE_LEN};
+pub use gauss::{GaussRecords, CONTACT_LEN, GAUSS_LEN, NODE_LEN};
 pub use particles::{ParticleSet, STATE_LEN};
 
 use crate::scene::{generate_particles, lattice, Scene};
@@ -92,12 +92,25 @@ pub struct CaseHeader {
 /// A new case at step 0: the scene's particle lattice and, for each point load, the particle
 /// nearest to its `at` point (ties go to the smaller gid).
 pub fn new_case(scene: &Scene, source: &str) -> (CaseHeader, ParticleSet) {
-    let particles = generate_particles(scene);
+    let mut particles = generate_particles(scene);
+    // Point loads' particles, then the probes'.
     let tracked_gids = scene
         .point_load
         .iter()
-        .filter_map(|p| lattice::nearest(&particles, p.at).map(|(gid, _)| gid))
+        .map(|p| p.at)
+        .chain(scene.probe.iter().map(|p| p.at))
+        .filter_map(|at| lattice::nearest(&particles, at).map(|(gid, _)| gid))
         .collect();
+    if let Some(g) = &scene.geostatic {
+        let gamma = scene.material.density * scene.gravity.g[0].hypot(scene.gravity.g[1]);
+        for (x, state) in particles.position.iter().zip(particles.state.iter_mut()) {
+            // Compression negative; the Gauss-state layout starts with σxx, σyy, σzz, σxy.
+            let sv = -(g.surcharge + gamma * (g.surface - x[1]).max(0.0));
+            state[0] = g.k0 * sv;
+            state[1] = sv;
+            state[2] = g.k0 * sv;
+        }
+    }
     let header = CaseHeader {
         format_version: FORMAT_VERSION,
         code_version: env!("CARGO_PKG_VERSION").to_string(),

@@ -1,10 +1,20 @@
 //! `history.csv`: one row per step with the scene's normalised load–displacement measures.
 //! The column names are a public interface (README, "Output").
 
-use crate::scene::{HistoryKind, Scene};
+use crate::scene::{HistoryKind, Measure, Scene};
 use std::fs::{self, File, OpenOptions};
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
+
+/// The header of `history.csv`: `step`, the kind's columns, then the declared ones.
+pub fn header(scene: &Scene) -> Vec<String> {
+    let mut h: Vec<String> = match scene.history.kind {
+        Some(kind) => columns(kind).iter().map(|c| c.to_string()).collect(),
+        None => vec!["step".to_string()],
+    };
+    h.extend(scene.history.columns.iter().map(|c| c.name.clone()));
+    h
+}
 
 pub fn columns(kind: HistoryKind) -> &'static [&'static str] {
     match kind {
@@ -15,9 +25,17 @@ pub fn columns(kind: HistoryKind) -> &'static [&'static str] {
 }
 
 /// Global measurements of a step, gathered by the driver.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Default)]
 pub struct Measures {
     pub load_factor: f64,
+    pub time: f64,
+    /// Total displacement of each `[[probe]]` particle, in scene order.
+    pub probes: Vec<[f64; 2]>,
+    /// Displacement and force (soil on body) of each `[[rigid]]` body, in scene order.
+    pub rigid_displacement: Vec<[f64; 2]>,
+    pub rigid_force: Vec<[f64; 2]>,
+    /// Reaction on each `[[fixed]]` entry, then each `[[prescribed]]` entry, in scene order.
+    pub set_reactions: Vec<[f64; 2]>,
     /// Total displacement of the first tracked particle.
     pub tracked_displacement: [f64; 2],
     /// Force on the particles of the first `[[prescribed]]` entry (footing, top platen).
@@ -30,9 +48,68 @@ pub struct Measures {
     pub driven_right: f64,
 }
 
-/// Normalised values of a row (after `step`).
+/// Normalised values of a row (after `step`): the kind's, then the declared columns.
 pub fn row(scene: &Scene, m: &Measures) -> Result<Vec<f64>, String> {
-    match scene.history.kind {
+    let mut values = match scene.history.kind {
+        Some(kind) => kind_row(scene, kind, m)?,
+        None => Vec::new(),
+    };
+    for c in &scene.history.columns {
+        let v = declared(scene, m, &c.measure)?;
+        values.push(c.scale * v);
+    }
+    Ok(values)
+}
+
+/// Value of a declared measure (validated names; a missing entry is an error, not a zero).
+fn declared(scene: &Scene, m: &Measures, measure: &str) -> Result<f64, String> {
+    let find = |list: Vec<Option<&String>>, name: &str| {
+        list.iter().position(|n| n.is_some_and(|n| n == name))
+    };
+    let missing = || format!("history measure \"{measure}\" names nothing in the scene");
+    Ok(match Measure::parse(measure)? {
+        Measure::LoadFactor => m.load_factor,
+        Measure::Time => m.time,
+        Measure::Area => m.area,
+        Measure::Probe(name, c) => {
+            let i = scene
+                .probe
+                .iter()
+                .position(|p| p.name == name)
+                .ok_or_else(missing)?;
+            m.probes.get(i).ok_or_else(missing)?[c]
+        }
+        Measure::RigidDisplacement(name, c) => {
+            let i = scene
+                .rigid
+                .iter()
+                .position(|r| r.name == name)
+                .ok_or_else(missing)?;
+            m.rigid_displacement.get(i).ok_or_else(missing)?[c]
+        }
+        Measure::RigidForce(name, c) => {
+            let i = scene
+                .rigid
+                .iter()
+                .position(|r| r.name == name)
+                .ok_or_else(missing)?;
+            m.rigid_force.get(i).ok_or_else(missing)?[c]
+        }
+        Measure::Reaction(name, c) => {
+            let names: Vec<Option<&String>> = scene
+                .fixed
+                .iter()
+                .map(|f| f.name.as_ref())
+                .chain(scene.prescribed.iter().map(|p| p.name.as_ref()))
+                .collect();
+            let i = find(names, &name).ok_or_else(missing)?;
+            m.set_reactions.get(i).ok_or_else(missing)?[c]
+        }
+    })
+}
+
+fn kind_row(scene: &Scene, kind: HistoryKind, m: &Measures) -> Result<Vec<f64>, String> {
+    match kind {
         HistoryKind::Cantilever => {
             let beam = scene
                 .body
@@ -99,9 +176,9 @@ pub struct HistoryFile {
 }
 
 impl HistoryFile {
-    pub fn open(dir: &Path, kind: HistoryKind, restart_step: u64) -> Result<HistoryFile, String> {
+    pub fn open(dir: &Path, scene: &Scene, restart_step: u64) -> Result<HistoryFile, String> {
         let path = dir.join("history.csv");
-        let header = columns(kind).join(",");
+        let header = header(scene).join(",");
         let mut kept = vec![header.clone()];
         if restart_step > 0 && path.exists() {
             let f = File::open(&path).map_err(|e| format!("{}: {e}", path.display()))?;

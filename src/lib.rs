@@ -17,6 +17,7 @@ pub mod output;
 pub mod particles;
 pub mod petsc;
 pub mod plot;
+pub mod rigid;
 pub mod rng;
 pub mod run;
 pub mod scene;

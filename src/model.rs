@@ -3,6 +3,7 @@
 use crate::material::elastic::LinearElastic;
 use crate::material::tresca::Tresca;
 use crate::material::Material;
+use crate::rigid::RigidBody;
 use crate::scene::{Axis, ElementChoice, MaterialModel, Prescribed, Scene, Selection};
 use crate::solve::Kernel;
 
@@ -12,6 +13,8 @@ pub struct Model {
     pub body_force: [f64; 2],
     /// Selector tolerance: 1e-9 of the body's size.
     pub tol: f64,
+    /// The `[[rigid]]` bodies, in scene order.
+    pub bodies: Vec<RigidBody>,
     pub scene: Scene,
 }
 
@@ -49,7 +52,14 @@ impl Model {
             .max((y1 - y0).abs())
             .max(x0.abs())
             .max(y0.abs());
+        let mut bodies = Vec::with_capacity(scene.rigid.len());
+        for (i, r) in scene.rigid.iter().enumerate() {
+            let shape = crate::scene::validate_rigid::shape_of(scene, i)
+                .map_err(|(path, e)| format!("{path}: {e}"))?;
+            bodies.push(RigidBody::new(r, shape, m.cu, scene.steps.count));
+        }
         Ok(Model {
+            bodies,
             material,
             kernel,
             body_force: [
@@ -111,6 +121,20 @@ impl Model {
             .prescribed
             .first()
             .is_some_and(|p| self.selects(p, x0, x, lambda))
+    }
+
+    /// Whether a particle is in set `set`: the `[[fixed]]` entries, then the `[[prescribed]]`
+    /// ones, in scene order.
+    pub fn in_set(&self, set: usize, x0: [f64; 2], x: [f64; 2], lambda: f64) -> bool {
+        let nf = self.scene.fixed.len();
+        if set < nf {
+            self.scene.fixed[set].region.matches(x0, self.tol)
+        } else {
+            self.scene
+                .prescribed
+                .get(set - nf)
+                .is_some_and(|p| self.selects(p, x0, x, lambda))
+        }
     }
 
     fn selects(&self, p: &Prescribed, x0: [f64; 2], x: [f64; 2], lambda: f64) -> bool {

@@ -50,17 +50,21 @@ pub mod builtin;
 #[path = "scene/error.rs"]
 mod error;
 #[path = "scene/field_path.rs"]
-mod field_path;
+pub mod field_path;
 #[path = "scene/lattice.rs"]
 pub mod lattice;
 #[path = "scene/overrides.rs"]
 mod overrides;
+#[path = "scene/rigid.rs"]
+pub mod rigid;
 #[path = "scene/schema.rs"]
 pub mod schema;
 #[path = "scene/selector.rs"]
 pub mod selector;
 #[path = "scene/validate.rs"]
 mod validate;
+#[path = "scene/validate_rigid.rs"]
+pub mod validate_rigid;
 #[path = "scene/value_de.rs"]
 mod value_de;
 
@@ -72,6 +76,10 @@ use serde::Deserialize;
 pub use builtin::{builtin, builtin_names, BUILTINS};
 pub use error::SceneError;
 pub use lattice::generate_particles;
+pub use rigid::{
+    Circle, Column, Contact, Geostatic, Measure, Polygon, Probe, ReferenceLine, Rigid, Stage,
+    SurfacePressure,
+};
 pub use schema::{
     Body, Dof, ElementChoice, FineRegion, Fixed, Gravity, History, HistoryKind, LineSearch,
     Material, MaterialModel, Mesh, Output, PointLoad, Prescribed, Rectangle, Scene, Selection,
@@ -127,7 +135,7 @@ impl Scene {
         }
 
         let tree = toml::Value::Table(table);
-        let scene = Scene::deserialize(ValueDeserializer::new(&tree)).map_err(|e| {
+        let mut scene = Scene::deserialize(ValueDeserializer::new(&tree)).map_err(|e| {
             let set = responsible_set(&parsed, &e.path);
             let message = match (e.kind, set) {
                 (DeErrorKind::UnknownKey, Some(_)) => {
@@ -143,6 +151,9 @@ impl Scene {
             }
         })?;
 
+        if scene.steps.count == 0 {
+            scene.steps.count = validate_rigid::stage_total(&scene).min(u32::MAX as u64) as u32;
+        }
         validate::validate(&scene).map_err(|(path, message)| SceneError {
             set: responsible_set(&parsed, &path).map(|s| s.raw.clone()),
             field: Some(path.to_string()),

@@ -19,6 +19,9 @@ pub const GAUSS_LEN: usize = 27;
 /// Node values per triangle: 6 nodes (vertices in key order, then the midside nodes of edges
 /// 01, 12, 20) x (displacement increment per whole step x, y; pressure, NaN if none).
 pub const NODE_LEN: usize = 18;
+/// Contact values per triangle: 6 nodes (as in `nodes`) x (rigid body index, contact pressure,
+/// shear stress), NaN where the node touched no body.
+pub const CONTACT_LEN: usize = 18;
 const GROUP: &str = "gauss";
 
 /// Triangles (smallest-gid vertex first, CCW) with their Gauss states.
@@ -28,6 +31,8 @@ pub struct GaussRecords {
     pub state: Vec<[f64; GAUSS_LEN]>,
     /// NaN where unknown (a file without `nodes`).
     pub nodes: Vec<[f64; NODE_LEN]>,
+    /// NaN where no contact (or a file without `contact`).
+    pub contact: Vec<[f64; CONTACT_LEN]>,
 }
 
 impl GaussRecords {
@@ -68,6 +73,14 @@ pub fn write(file: &File, g: &GaussRecords, rows: Range<usize>, n: usize) -> hdf
         rows.clone(),
         g.nodes.as_flattened(),
     )?;
+    column(
+        file,
+        "contact",
+        CONTACT_LEN,
+        n,
+        rows.clone(),
+        g.contact.as_flattened(),
+    )?;
     column(file, "state", GAUSS_LEN, n, rows, g.state.as_flattened())
 }
 
@@ -105,7 +118,17 @@ pub fn read(
         key: vec![[0; 3]; rows.len()],
         state: vec![[0.0; GAUSS_LEN]; rows.len()],
         nodes: vec![[f64::NAN; NODE_LEN]; rows.len()],
+        contact: vec![[f64::NAN; CONTACT_LEN]; rows.len()],
     };
+    let contact = group.dataset("contact").ok();
+    if let Some(cs) = contact.as_ref().map(|d| d.shape()) {
+        if cs.len() != 2 || cs[1] != CONTACT_LEN || cs[0] != ks[0] {
+            return Err(bad(
+                "contact",
+                format!("expected shape ({}, {CONTACT_LEN}), found {cs:?}", ks[0]),
+            ));
+        }
+    }
     let nodes = group.dataset("nodes").ok();
     if let Some(ns) = nodes.as_ref().map(|d| d.shape()) {
         if ns.len() != 2 || ns[1] != NODE_LEN || ns[0] != ks[0] {
@@ -121,6 +144,13 @@ pub fn read(
             &key.space()?.select((rows.clone(), ..))?,
             g.key.as_flattened_mut(),
         )?;
+        if let Some(contact) = &contact {
+            ffi::read_collective(
+                contact,
+                &contact.space()?.select((rows.clone(), ..))?,
+                g.contact.as_flattened_mut(),
+            )?;
+        }
         if let Some(nodes) = &nodes {
             ffi::read_collective(
                 nodes,

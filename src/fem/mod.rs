@@ -6,3 +6,4 @@ pub mod mixed;
 pub mod p2;
 pub mod quadrature;
 pub mod recovery;
+pub mod surface_load;

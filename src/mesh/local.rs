@@ -73,31 +73,65 @@ impl LocalMesh {
             .map(|(t, _)| canonical(*t, &gids))
             .collect();
         tris.sort_by_key(|t| key(t, &gids));
-        let tri_owned = tris.iter().map(|t| owner[t[0] as usize] == rank).collect();
-        let bedges: Vec<[u32; 2]> = boundary_edges(&tris)
-            .into_iter()
-            .filter(|e| (e[0] as usize) < n_owned || (e[1] as usize) < n_owned)
-            .collect();
-        let mut on_boundary = vec![false; n_owned];
-        for e in &bedges {
-            for &v in e {
-                if (v as usize) < n_owned {
-                    on_boundary[v as usize] = true;
-                }
-            }
-        }
-        Ok(LocalMesh {
+        let mut mesh = LocalMesh {
             points,
             gids,
             n_owned,
             owner,
             h,
             tris,
-            tri_owned,
-            on_boundary,
-            boundary_edges: bedges,
+            tri_owned: Vec::new(),
+            on_boundary: Vec::new(),
+            boundary_edges: Vec::new(),
             ties_settled,
-        })
+        };
+        mesh.derive(rank);
+        Ok(mesh)
+    }
+
+    /// Ownership and boundary from `tris`.
+    fn derive(&mut self, rank: i32) {
+        let n_owned = self.n_owned;
+        self.tri_owned = self
+            .tris
+            .iter()
+            .map(|t| self.owner[t[0] as usize] == rank)
+            .collect();
+        self.boundary_edges = boundary_edges(&self.tris)
+            .into_iter()
+            .filter(|e| (e[0] as usize) < n_owned || (e[1] as usize) < n_owned)
+            .collect();
+        self.on_boundary = vec![false; n_owned];
+        for e in &self.boundary_edges {
+            for &v in e {
+                if (v as usize) < n_owned {
+                    self.on_boundary[v as usize] = true;
+                }
+            }
+        }
+    }
+
+    /// Removes the triangles `drop` rejects (given their points and the vertices' largest
+    /// spacing). `drop` must depend only on those values, so that every rank holding a copy
+    /// of a triangle decides the same. Returns how many were removed.
+    pub fn drop_triangles(
+        &mut self,
+        rank: i32,
+        drop: impl Fn([[f64; 2]; 3], f64) -> bool,
+    ) -> usize {
+        let before = self.tris.len();
+        let points = &self.points;
+        let h = &self.h;
+        self.tris.retain(|t| {
+            let p = t.map(|v| points[v as usize]);
+            let hmax = t.iter().map(|&v| h[v as usize]).fold(0.0, f64::max);
+            !drop(p, hmax)
+        });
+        let removed = before - self.tris.len();
+        if removed > 0 {
+            self.derive(rank);
+        }
+        removed
     }
 
     /// The triangle's global-id key (smallest gid first, CCW).

@@ -1,5 +1,6 @@
 //! The PFEM step loop (the method's Fig. 1): remesh, map, solve, update, output, checkpoint.
 
+mod contact;
 mod output;
 mod progress;
 mod refinement;

@@ -16,6 +16,16 @@ pub struct Output {
     fields: FieldsWriter,
 }
 
+/// `DIR/scene.toml`: the resolved scene of the run, which the plots read for the declared
+/// columns' reference lines (written to a temporary name and renamed).
+fn write_scene(dir: &Path, sim: &Simulation) -> Result<(), String> {
+    let path = dir.join("scene.toml");
+    let tmp = dir.join("scene.toml.tmp");
+    std::fs::write(&tmp, sim.scene().to_toml())
+        .and_then(|_| std::fs::rename(&tmp, &path))
+        .map_err(|e| format!("{}: {e}", path.display()))
+}
+
 impl Output {
     /// Collective. Creates `DIR` (rank 0) and opens the history, keeping rows of earlier runs up to
     /// the restart step.
@@ -25,7 +35,8 @@ impl Output {
         if world.rank() == 0 {
             match std::fs::create_dir_all(dir.join("checkpoints"))
                 .map_err(|e| format!("{}: {e}", dir.display()))
-                .and_then(|_| HistoryFile::open(dir, sim.scene().history.kind, sim.step()))
+                .and_then(|_| write_scene(dir, sim))
+                .and_then(|_| HistoryFile::open(dir, sim.scene(), sim.step()))
             {
                 Ok(h) => history = Some(h),
                 Err(e) => local = Some(e),

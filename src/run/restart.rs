@@ -3,7 +3,9 @@
 //! rank whose owned particles touch the triangle.
 
 use super::Simulation;
-use crate::case_file::{write_checkpoint, GaussRecords, ParticleSet, GAUSS_LEN, NODE_LEN};
+use crate::case_file::{
+    write_checkpoint, GaussRecords, ParticleSet, CONTACT_LEN, GAUSS_LEN, NODE_LEN,
+};
 use crate::mapping::TriStates;
 use crate::material::GaussState;
 use crate::particles::flag;
@@ -41,6 +43,7 @@ impl Simulation {
         };
         let mut records = GaussRecords::default();
         let last = self.last_nodes.borrow();
+        let touching = self.last_contact.borrow();
         for (key, states) in self.tri_states.iter() {
             // Each triangle once: by the owner of its smallest-gid vertex.
             if p.gid.binary_search(&key[0]).is_ok() {
@@ -57,6 +60,15 @@ impl Simulation {
                     }
                 }
                 records.nodes.push(nodes);
+                let mut contact = [f64::NAN; CONTACT_LEN];
+                for (k, node) in tri_node_keys(key).iter().enumerate() {
+                    let touched = (0..self.model.bodies.len() as u32)
+                        .find_map(|b| touching.get(&(*node, b)).map(|v| (b, v)));
+                    if let Some((b, v)) = touched {
+                        contact[3 * k..3 * k + 3].copy_from_slice(&[b as f64, v[0], v[1]]);
+                    }
+                }
+                records.contact.push(contact);
             }
         }
         let mut header = self.header.clone();
@@ -82,13 +94,14 @@ impl Simulation {
                 send[r as usize].extend_from_slice(key);
                 send[r as usize].extend(records.state[t].iter().map(|x| x.to_bits()));
                 send[r as usize].extend(records.nodes[t].iter().map(|x| x.to_bits()));
+                send[r as usize].extend(records.contact[t].iter().map(|x| x.to_bits()));
             }
         }
         let received = alltoallv(world, &send);
         let chunks = || {
             received
                 .iter()
-                .flat_map(|r| r.chunks_exact(3 + GAUSS_LEN + NODE_LEN))
+                .flat_map(|r| r.chunks_exact(3 + GAUSS_LEN + NODE_LEN + CONTACT_LEN))
         };
         let mut last = self.last_nodes.borrow_mut();
         last.clear();
@@ -103,6 +116,18 @@ impl Simulation {
             }
         }
         drop(last);
+        let mut touching = self.last_contact.borrow_mut();
+        touching.clear();
+        for c in chunks() {
+            let contact = &c[3 + GAUSS_LEN + NODE_LEN..];
+            for (k, node) in tri_node_keys(&[c[0], c[1], c[2]]).iter().enumerate() {
+                let v: [f64; 3] = std::array::from_fn(|i| f64::from_bits(contact[3 * k + i]));
+                if !v[0].is_nan() {
+                    touching.insert((*node, v[0] as u32), [v[1], v[2]]);
+                }
+            }
+        }
+        drop(touching);
         let pairs = chunks()
             .map(|c| {
                 let states = std::array::from_fn(|q| {

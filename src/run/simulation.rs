@@ -13,6 +13,9 @@ use mpi::traits::Communicator;
 use pfem_partition::{imbalance, max_f64, migrate, partition_graph, sum_f64, Comm};
 use std::path::Path;
 
+/// A triangle reaching deeper than this fraction of its spacing into a rigid body is removed.
+pub const CROSSING_DEPTH: f64 = 0.25;
+
 /// Repartition when the largest rank holds this much more than the mean.
 const IMBALANCE_LIMIT: f64 = 1.2;
 
@@ -25,6 +28,16 @@ pub struct Simulation {
     /// This rank's share of the last step's footing/platen reaction and body area.
     pub(super) last_reaction: [f64; 2],
     pub(super) last_area: f64,
+    /// This rank's share of the last step's reaction on each `[[fixed]]` then `[[prescribed]]`
+    /// entry, and of the soil's force on each rigid body.
+    pub(super) last_set_reactions: Vec<[f64; 2]>,
+    pub(super) last_body_force: Vec<[f64; 2]>,
+    /// Contact pressure and shear per contact node of the last increment.
+    pub(super) last_contact: std::cell::RefCell<super::contact::ContactState>,
+    /// Contact augmentations (Newton solves after the first) since the last step report.
+    pub(super) augmentations: std::cell::Cell<u64>,
+    /// Seconds spent on contact since the last step report.
+    pub(super) contact_seconds: std::cell::Cell<f64>,
     /// PETSc objects of the last increment (kept while the matrix pattern stays the same).
     pub(super) solver: std::cell::RefCell<Option<super::step::SolverObjects>>,
     /// The last increment's nodal solution by global node ([gid, gid] for a vertex, the sorted
@@ -45,6 +58,12 @@ pub struct StepReport {
     pub remapped: u64,
     pub particles: u64,
     pub triangles: u64,
+    /// Contact augmentations (Newton solves after the first) in the step, all ranks.
+    pub augmentations: usize,
+    /// Deepest particle penetration into a rigid body, as a fraction of its spacing.
+    pub penetration: f64,
+    /// Seconds of the step spent on contact (part of the solve phase); 0 without bodies.
+    pub contact_seconds: f64,
 }
 
 fn err<E: std::fmt::Display>(e: E) -> String {
@@ -83,6 +102,11 @@ impl Simulation {
             tri_states: TriStates::default(),
             last_reaction: [0.0; 2],
             last_area: 0.0,
+            last_set_reactions: Vec::new(),
+            last_body_force: Vec::new(),
+            last_contact: Default::default(),
+            augmentations: Default::default(),
+            contact_seconds: Default::default(),
             solver: Default::default(),
             last_nodes: Default::default(),
             remapped: Default::default(),
@@ -143,7 +167,8 @@ impl Simulation {
         let h: Vec<f64> = p.h.iter().chain(&g.h).copied().collect();
         let alpha = self.model.scene.mesh.alpha;
         let n = p.len();
-        let mesh = LocalMesh::build(points, gids, owner, h, n, rank, alpha, true).map_err(err)?;
+        let mut mesh =
+            LocalMesh::build(points, gids, owner, h, n, rank, alpha, true).map_err(err)?;
         // One rank's unsettled near ties put every rank back on the exact Delaunay mesh.
         if max_f64(world, if mesh.ties_settled { 0.0 } else { 1.0 }) > 0.0 {
             let LocalMesh {
@@ -153,9 +178,31 @@ impl Simulation {
                 h,
                 ..
             } = mesh;
-            return LocalMesh::build(points, gids, owner, h, n, rank, alpha, false).map_err(err);
+            mesh = LocalMesh::build(points, gids, owner, h, n, rank, alpha, false).map_err(err)?;
         }
+        self.drop_crossing(&mut mesh, rank);
         Ok(mesh)
+    }
+
+    /// Removes the triangles that reach into a rigid body deeper than a quarter of their
+    /// spacing: the alpha shape alone would bridge particles across a thin body, or close the
+    /// soil over a body's corner. A chord between two particles on a curved face dips into the
+    /// body by only h²/8R, far less. Rank-local and decided from the triangle's own data.
+    fn drop_crossing(&self, mesh: &mut LocalMesh, rank: i32) {
+        if self.model.bodies.is_empty() {
+            return;
+        }
+        let lambda = self.header.load_factor;
+        let shapes: Vec<_> = self.model.bodies.iter().map(|b| b.shape(lambda)).collect();
+        let boxes: Vec<_> = shapes.iter().map(|s| s.bounding_box()).collect();
+        mesh.drop_triangles(rank, |p, h| {
+            shapes.iter().zip(&boxes).any(|(s, bb)| {
+                let lo = |c: usize| p.iter().map(|q| q[c]).fold(f64::INFINITY, f64::min);
+                let hi = |c: usize| p.iter().map(|q| q[c]).fold(f64::NEG_INFINITY, f64::max);
+                let apart = (0..2).any(|c| lo(c) > bb[1][c] || hi(c) < bb[0][c]);
+                !apart && s.triangle_depth(p) > CROSSING_DEPTH * h
+            })
+        });
     }
 
     /// Start-of-step Gauss states on the new mesh (rank-local).
@@ -220,7 +267,38 @@ impl Simulation {
         );
         let right = max_f64(world, hi);
         let width = right + max_f64(world, -lo);
+        // Probes follow the point loads in `tracked_gids`.
+        let n_loads = self.model.scene.point_load.len();
+        let mut local = Vec::new();
+        for k in 0..self.model.scene.probe.len() {
+            let gid = self.header.tracked_gids.get(n_loads + k);
+            let u = gid
+                .and_then(|g| self.particles.gid.binary_search(g).ok())
+                .map_or([0.0; 2], |i| self.particles.displacement[i]);
+            local.extend(u);
+        }
+        let n_sets = self.model.scene.fixed.len() + self.model.scene.prescribed.len();
+        for k in 0..n_sets {
+            local.extend(self.last_set_reactions.get(k).copied().unwrap_or([0.0; 2]));
+        }
+        for k in 0..self.model.bodies.len() {
+            local.extend(self.last_body_force.get(k).copied().unwrap_or([0.0; 2]));
+        }
+        let summed = sum_f64(world, &local);
+        let pairs = |v: &[f64]| v.chunks_exact(2).map(|c| [c[0], c[1]]).collect::<Vec<_>>();
+        let n_probe = 2 * self.model.scene.probe.len();
+        let lambda = self.header.load_factor;
         Measures {
+            time: self.header.time,
+            probes: pairs(&summed[..n_probe]),
+            set_reactions: pairs(&summed[n_probe..n_probe + 2 * n_sets]),
+            rigid_force: pairs(&summed[n_probe + 2 * n_sets..]),
+            rigid_displacement: self
+                .model
+                .bodies
+                .iter()
+                .map(|b| b.displacement(lambda))
+                .collect(),
             load_factor: self.header.load_factor,
             tracked_displacement: [s[0], s[1]],
             reaction: [s[2], s[3]],

@@ -8,7 +8,7 @@ use crate::mesh::LocalMesh;
 use crate::petsc::{Mat, PVec, Petsc, Snes};
 use crate::scene::LineSearch;
 use crate::solve::{Constraints, DofMap, StepProblem, StepSetup};
-use pfem_partition::{sum_f64, Comm};
+use pfem_partition::{max_f64, sum_f64, Comm};
 
 /// PETSc objects reused across increments with the same matrix pattern.
 pub struct SolverObjects {
@@ -63,8 +63,29 @@ pub struct Solved {
     pressure: Vec<f64>,
     states: Vec<[GaussState; 3]>,
     reaction: [f64; 2],
+    /// Reaction on each `[[fixed]]`, then `[[prescribed]]` entry (named ones; others zero).
+    set_reactions: Vec<[f64; 2]>,
+    /// Force of the soil on each rigid body (this rank's nodes).
+    body_force: Vec<[f64; 2]>,
+    /// Pressure and shear of every contact node at the solution.
+    contact_state: super::contact::ContactState,
     newton_iterations: usize,
     residual_norm: f64,
+    /// Newton solves after the first (contact augmentations), all ranks.
+    augmentations: usize,
+}
+
+/// The converged increment.
+struct Outcome {
+    du: Vec<[f64; 2]>,
+    pressure: Vec<f64>,
+    states: Vec<[GaussState; 3]>,
+    reaction: [f64; 2],
+    set_reactions: Vec<[f64; 2]>,
+    body_force: Vec<[f64; 2]>,
+    contact_state: super::contact::ContactState,
+    stats: crate::petsc::SolveStats,
+    augmentations: usize,
 }
 
 /// Global identity of local node `n`: a vertex's particle id twice, or an edge's two particle
@@ -138,6 +159,10 @@ impl Simulation {
                 }
             }
         }
+        let clock = std::time::Instant::now();
+        let loads = self.boundary_loads(mesh, &dofs, from, to);
+        self.add_contact_time(clock);
+        let spacing = loads.spacing;
         let setup = StepSetup {
             material: self.model.material.as_ref(),
             kernel: self.model.kernel,
@@ -145,22 +170,31 @@ impl Simulation {
             body_force: self.model.body_force,
             constraints: &constraints,
             point_loads,
+            contact: loads.pairs,
+            bodies: loads.bodies,
+            surface: loads.surface,
         };
         let mut cache = self
             .solver_objects(world, &dofs)
             .map_err(|e| err(e.to_string()))?;
-        let outcome = self.solve_with(world, mesh, &dofs, setup, &mut cache, scale, from, step);
+        let outcome = self.solve_with(
+            world, mesh, &dofs, setup, &spacing, &mut cache, scale, from, step,
+        );
         // Kept for the next increment on the same pattern (a cut piece, or an unchanged mesh).
         *self.solver.borrow_mut() = Some(cache);
-        outcome.map(|(du, pressure, states, reaction, stats)| Solved {
+        outcome.map(|o| Solved {
             dlambda: to - from,
             dofs,
-            du,
-            pressure,
-            states,
-            reaction,
-            newton_iterations: stats.newton_iterations,
-            residual_norm: stats.residual_norm,
+            du: o.du,
+            pressure: o.pressure,
+            states: o.states,
+            reaction: o.reaction,
+            set_reactions: o.set_reactions,
+            body_force: o.body_force,
+            contact_state: o.contact_state,
+            newton_iterations: o.stats.newton_iterations,
+            residual_norm: o.stats.residual_norm,
+            augmentations: o.augmentations,
         })
     }
 
@@ -206,27 +240,19 @@ impl Simulation {
         })
     }
 
-    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    #[allow(clippy::too_many_arguments)]
     fn solve_with(
         &self,
         world: &Comm,
         mesh: &LocalMesh,
         dofs: &DofMap,
         setup: StepSetup,
+        spacing: &[f64],
         objects: &mut SolverObjects,
         scale: f64,
         from: f64,
         step: u64,
-    ) -> Result<
-        (
-            Vec<[f64; 2]>,
-            Vec<f64>,
-            Vec<[GaussState; 3]>,
-            [f64; 2],
-            crate::petsc::SolveStats,
-        ),
-        SolveError,
-    > {
+    ) -> Result<Outcome, SolveError> {
         let err = |e: String| SolveError::Fatal(e);
         let SolverObjects { x, jac, snes, .. } = objects;
         let mut problem =
@@ -260,14 +286,44 @@ impl Simulation {
                 }
             })
             .map_err(|e| err(e.to_string()))?;
-        let stats = snes.solve(&mut problem, x, jac).map_err(|e| {
-            let msg = format!("step {step}: {}", e.message);
-            if e.is_divergence() {
-                SolveError::Diverged(msg)
-            } else {
-                SolveError::Fatal(msg)
+        let mut newton = |problem: &mut StepProblem, x: &mut PVec, jac: &mut Mat| {
+            snes.solve(problem, x, jac).map_err(|e| {
+                let msg = format!("step {step}: {}", e.message);
+                if e.is_divergence() {
+                    SolveError::Diverged(msg)
+                } else {
+                    SolveError::Fatal(msg)
+                }
+            })
+        };
+        let mut stats = newton(&mut problem, x, jac)?;
+        // Augmented Lagrangian: re-solve with the multipliers set to the converged pressures
+        // until they settle (every rank agrees through the reductions).
+        let contact = &self.model.scene.contact;
+        let mut augmentations = 0;
+        let clock = std::time::Instant::now();
+        if !self.model.bodies.is_empty()
+            && sum_f64(world, &[problem.contact_pairs().len() as f64])[0] > 0.0
+        {
+            loop {
+                let local = problem
+                    .local_values(x.as_ref())
+                    .map_err(|e| err(e.to_string()))?;
+                let a = problem.augment(&local, spacing);
+                let change = max_f64(world, a.change);
+                let pressure = max_f64(world, a.pressure);
+                if change <= contact.tolerance * pressure
+                    || augmentations + 1 >= contact.max_augmentations as usize
+                {
+                    break;
+                }
+                augmentations += 1;
+                let more = newton(&mut problem, x, jac)?;
+                stats.newton_iterations += more.newton_iterations;
+                stats.residual_norm = more.residual_norm;
             }
-        })?;
+        }
+        self.add_contact_time(clock);
         let local = problem
             .local_values(x.as_ref())
             .map_err(|e| err(e.to_string()))?;
@@ -291,15 +347,78 @@ impl Simulation {
             })
         };
         let reaction = problem.reaction(&elems, driven);
+        let set_reactions = self.set_reactions(mesh, dofs, &problem, &elems, from);
+        let mut body_force = vec![[0.0; 2]; self.model.bodies.len()];
+        let mut contact_state = super::contact::ContactState::new();
+        for (c, f) in problem
+            .contact_pairs()
+            .iter()
+            .zip(problem.contact_forces(&local))
+        {
+            let b = &mut body_force[c.body as usize];
+            b[0] -= f.force[0];
+            b[1] -= f.force[1];
+            if f.pressure > 0.0 {
+                let key = node_key(mesh, dofs, c.node as usize);
+                contact_state.insert((key, c.body), [f.pressure, f.shear]);
+            }
+        }
         let du = problem.node_displacements(&local);
         let pressure = problem.node_pressures(&local);
-        Ok((
+        Ok(Outcome {
             du,
             pressure,
-            elems.into_iter().map(|e| e.states).collect(),
+            states: elems.into_iter().map(|e| e.states).collect(),
             reaction,
+            set_reactions,
+            body_force,
+            contact_state,
             stats,
-        ))
+            augmentations,
+        })
+    }
+
+    /// Reactions on the named `[[fixed]]` and `[[prescribed]]` sets (unnamed ones: zero, not
+    /// computed).
+    fn set_reactions(
+        &self,
+        mesh: &LocalMesh,
+        dofs: &DofMap,
+        problem: &StepProblem,
+        elems: &[crate::solve::problem::ElementResult],
+        from: f64,
+    ) -> Vec<[f64; 2]> {
+        let scene = &self.model.scene;
+        let names = scene
+            .fixed
+            .iter()
+            .map(|f| f.name.is_some())
+            .chain(scene.prescribed.iter().map(|p| p.name.is_some()));
+        let n_vertex = dofs.n_nodes() - dofs.edges.len();
+        names
+            .enumerate()
+            .map(|(set, named)| {
+                if !named {
+                    return [0.0; 2];
+                }
+                problem.reaction(elems, |n| {
+                    let pts: Vec<u32> = if n < n_vertex {
+                        vec![dofs.node_point[n]]
+                    } else {
+                        dofs.edges[n - n_vertex].to_vec()
+                    };
+                    pts.iter().all(|&p| {
+                        let p = p as usize;
+                        self.model.in_set(
+                            set,
+                            self.reference_position(mesh, p),
+                            mesh.points[p],
+                            from,
+                        )
+                    })
+                })
+            })
+            .collect()
     }
 
     /// Collective. Moves the particles and carries the new Gauss states to them.
@@ -335,6 +454,11 @@ impl Simulation {
         self.particles.state = recover_at_particles(mesh, &solved.states, &self.particles.state);
         self.tri_states = TriStates::new(mesh, solved.states);
         self.last_reaction = solved.reaction;
+        self.last_set_reactions = solved.set_reactions;
+        self.last_body_force = solved.body_force;
+        *self.last_contact.borrow_mut() = solved.contact_state;
+        self.augmentations
+            .set(self.augmentations.get() + solved.augmentations as u64);
         self.last_area = owned_area(mesh, &solved.du, &solved.dofs);
         if completes {
             self.header.step += 1;
@@ -357,7 +481,18 @@ impl Simulation {
             particles: counts[0] as u64,
             triangles: counts[1] as u64,
             remapped: counts[2] as u64,
+            augmentations: 0,
+            penetration: 0.0,
+            contact_seconds: 0.0,
         })
+    }
+}
+
+impl Simulation {
+    /// Time spent on contact: finding pairs and the Newton solves of the augmentations.
+    fn add_contact_time(&self, since: std::time::Instant) {
+        self.contact_seconds
+            .set(self.contact_seconds.get() + since.elapsed().as_secs_f64());
     }
 }
 
@@ -391,11 +526,14 @@ impl Simulation {
                 Ok(solved) => {
                     let completes = to == target;
                     let mut report = self.update(world, mesh, solved, completes)?;
+                    report.penetration = self.check_penetration(world)?;
                     newton += report.newton_iterations;
                     remapped += report.remapped;
                     if completes {
                         report.newton_iterations = newton;
                         report.remapped = remapped;
+                        report.augmentations = self.augmentations.take() as usize;
+                        report.contact_seconds = self.contact_seconds.take();
                         report.cuts = cuts;
                         return Ok(report);
                     }

@@ -12,6 +12,10 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "block-compression",
         include_str!("builtin/block-compression.toml"),
     ),
+    ("footing", include_str!("builtin/footing.toml")),
+    ("tbar-smooth", include_str!("builtin/tbar-smooth.toml")),
+    ("tbar-rough", include_str!("builtin/tbar-rough.toml")),
+    ("pipeline", include_str!("builtin/pipeline.toml")),
 ];
 
 /// TOML text of the built-in scene `name`.

@@ -101,6 +101,58 @@ pub fn generate_particles(scene: &Scene) -> ParticleSet {
     for i in 0..set.len() {
         set.position[i] = jittered(scene, set.gid[i], set.position[i], set.h[i]);
     }
+    if !scene.rigid.is_empty() {
+        set = carve_rigid(scene, set);
+    }
+    set
+}
+
+/// Removes the particles inside the rigid bodies, and lines the part of a body's surface that
+/// lies inside the soil (a body wished in place) with particles at the spacing of the cloud
+/// around it, dropping lattice particles closer than half that spacing to them. A body resting
+/// on the surface only touches the body's outline and changes nothing there.
+fn carve_rigid(scene: &Scene, base: ParticleSet) -> ParticleSet {
+    let tol = scene.tolerance();
+    let shapes: Vec<_> = (0..scene.rigid.len())
+        .filter_map(|i| super::validate_rigid::shape_of(scene, i).ok())
+        .collect();
+    let strictly_inside = |p: [f64; 2], margin: f64| {
+        scene.body.rectangles.iter().any(|r| {
+            (0..2).all(|c| p[c] > r.origin[c] + margin && p[c] < r.origin[c] + r.size[c] - margin)
+        })
+    };
+    let mut ring: Vec<([f64; 2], f64)> = Vec::new();
+    for shape in &shapes {
+        let near = 2.0 * scene.mesh.h;
+        let spacing = base
+            .position
+            .iter()
+            .zip(&base.h)
+            .filter(|(p, _)| shape.closest(**p).distance < near)
+            .map(|(_, h)| *h)
+            .fold(scene.mesh.h, f64::min);
+        for p in shape.surface_points(spacing) {
+            if strictly_inside(p, 0.25 * spacing) {
+                ring.push((p, spacing));
+            }
+        }
+    }
+    let mut points: Vec<([f64; 2], f64)> = Vec::with_capacity(base.len() + ring.len());
+    for (p, h) in base.position.iter().zip(&base.h) {
+        let inside = shapes.iter().any(|s| s.closest(*p).distance < -tol);
+        let crowded = ring
+            .iter()
+            .any(|(q, hq)| (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) < 0.25 * hq * hq);
+        if !inside && !crowded {
+            points.push((*p, *h));
+        }
+    }
+    points.extend(ring);
+    points.sort_by(|a, b| a.0[1].total_cmp(&b.0[1]).then(a.0[0].total_cmp(&b.0[0])));
+    let mut set = ParticleSet::with_capacity(points.len());
+    for (gid, (p, h)) in points.into_iter().enumerate() {
+        set.push_new(gid as u64, p, h);
+    }
     set
 }
 

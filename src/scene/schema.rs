@@ -4,6 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::rigid::{Column, Contact, Geostatic, Probe, Rigid, SurfacePressure};
 use super::selector::Selector;
 
 /// A complete, validated problem description.
@@ -27,12 +28,33 @@ pub struct Scene {
     /// `[[prescribed]]` entries: imposed displacements (footings, platens).
     #[serde(default)]
     pub prescribed: Vec<Prescribed>,
+    /// `[[rigid]]` bodies pushed into the soil, with contact.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rigid: Vec<Rigid>,
+    /// `[contact]`: penalty and augmentation of the contact with every rigid body.
+    #[serde(default, skip_serializing_if = "is_default_contact")]
+    pub contact: Contact,
+    /// `[[surface_pressure]]`: follower pressures on the free surface.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub surface_pressure: Vec<SurfacePressure>,
+    /// `[geostatic]`: initial stress from self-weight, surcharge and K0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geostatic: Option<Geostatic>,
+    /// `[[probe]]`: particles whose displacement history columns read.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub probe: Vec<Probe>,
+    /// May be left out when `[[rigid]]` stages set the step count.
+    #[serde(default)]
     pub steps: Steps,
     pub history: History,
     #[serde(default)]
     pub output: Output,
     #[serde(default)]
     pub solver: Solver,
+}
+
+fn is_default_contact(c: &Contact) -> bool {
+    *c == Contact::default()
 }
 
 /// `[body]`: the initial domain, a union of axis-aligned rectangles filled with a square
@@ -186,6 +208,9 @@ impl Dof {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Fixed {
+    /// Optional name for history measures (`reaction.NAME.fy`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
     /// `where = "x <= 0"`: comparisons `x <= c`, `x >= c`, `y <= c`, `y >= c` joined by `and`;
     /// boundaries are matched within 1e-9 times the body's largest dimension.
     #[serde(rename = "where")]
@@ -209,6 +234,9 @@ pub struct PointLoad {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Prescribed {
+    /// Optional name for history measures (`reaction.NAME.fy`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
     /// Same syntax as `fixed.where`, e.g. `"y >= 10 and x <= 1"`.
     #[serde(rename = "where")]
     pub region: Selector,
@@ -245,10 +273,13 @@ impl Selection {
 }
 
 /// `[steps]`: load stepping.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Steps {
-    /// Number of load steps, >= 1; the load factor goes from 0 to 1 in equal increments.
+    /// Number of load steps, >= 1; the load factor goes from 0 to 1 in equal increments. With
+    /// `[[rigid]]` stages it may be left out: it is then the longest body's stage total (and if
+    /// given, it must equal that total).
+    #[serde(default)]
     pub count: u32,
 }
 
@@ -274,12 +305,16 @@ impl HistoryKind {
     }
 }
 
-/// `[history]`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// `[history]`: the built-in columns of `kind`, then the declared `columns`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct History {
-    /// `"cantilever"`, `"footing"` or `"block"`.
-    pub kind: HistoryKind,
+    /// `"cantilever"`, `"footing"` or `"block"`: the legacy benchmark columns. Optional.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kind: Option<HistoryKind>,
+    /// `[[history.columns]]`: named measurements, each with a scale factor.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub columns: Vec<Column>,
 }
 
 /// `[output]`: checkpointing.

@@ -35,7 +35,7 @@ fn builtins_parse_validate_and_round_trip() {
     assert!(footing.material.cu > 0.0);
     let (block, _) = load_scene("block-compression", &[]).unwrap();
     assert_eq!(block.material.model, MaterialModel::Tresca);
-    assert_eq!(block.history.kind, HistoryKind::Block);
+    assert_eq!(block.history.kind, Some(HistoryKind::Block));
 }
 
 #[test]

@@ -185,7 +185,7 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
 
     let kind = root.join("history").join("kind");
     match s.history.kind {
-        HistoryKind::Cantilever if s.point_load.is_empty() => {
+        Some(HistoryKind::Cantilever) if s.point_load.is_empty() => {
             return fail(
                 kind,
                 "\"cantilever\" records the displacement of the first [[point_load]]'s \
@@ -193,13 +193,13 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
                     .to_string(),
             );
         }
-        HistoryKind::Footing | HistoryKind::Block if s.prescribed.is_empty() => {
+        Some(HistoryKind::Footing | HistoryKind::Block) if s.prescribed.is_empty() => {
             return fail(
                 kind,
                 format!(
                     "\"{}\" records the force on the [[prescribed]] particles, but the scene \
                      has no [[prescribed]]",
-                    s.history.kind.as_str()
+                    s.history.kind.map_or("", |k| k.as_str())
                 ),
             );
         }
@@ -328,6 +328,7 @@ fn check_against_particles(s: &Scene) -> Result<(), Invalid> {
 
 pub fn validate(s: &Scene) -> Result<(), Invalid> {
     check_fields(s)?;
+    super::validate_rigid::check(s)?;
     check_alignment(s)?;
     check_against_particles(s)
 }

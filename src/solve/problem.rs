@@ -7,10 +7,12 @@ use super::{Constraints, DofMap};
 use crate::fem::element::p2_element;
 use crate::fem::mixed::p2p1_element;
 use crate::fem::p2::straight_sided;
+use crate::fem::surface_load::edge_pressure;
 use crate::material::{GaussState, Material};
 use crate::mesh::LocalMesh;
 use crate::petsc::snes::{CallbackError, NonlinearProblem};
 use crate::petsc::{matrix::MatRef, PVec, PetscError, Scatter, VecRef};
+use crate::rigid::{pair_force, ContactPair, PairForce, Shape};
 use pfem_partition::{agree_on_error, Comm};
 
 /// The element family of a step.
@@ -34,6 +36,23 @@ pub struct StepSetup<'a> {
     pub constraints: &'a Constraints,
     /// Total external point forces on owned nodes at the end of the step: (node, force).
     pub point_loads: Vec<(u32, [f64; 2])>,
+    /// Soil nodes facing rigid bodies (owned nodes only), and the bodies at the end of the step.
+    pub contact: Vec<ContactPair>,
+    pub bodies: Vec<Shape>,
+    /// Follower pressures on boundary edges touching an owned node: nodes [a, m, b] (body on
+    /// the left of a→b) and the pressure.
+    pub surface: Vec<([u32; 3], f64)>,
+}
+
+/// What an augmentation of the contact multipliers changed (this rank's share).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Augmentation {
+    /// Largest change of a node's multiplier (Pa).
+    pub change: f64,
+    /// Largest contact pressure (Pa).
+    pub pressure: f64,
+    /// Largest penetration as a fraction of the node's spacing.
+    pub penetration: f64,
 }
 
 /// One element's contribution: residual, row-major tangent, states; dof order as the element's.
@@ -230,6 +249,87 @@ impl<'a> StepProblem<'a> {
         Some(self.dofs.node_global[node] - self.dofs.first_dof + c)
     }
 
+    fn node_u(&self, local: &[f64], n: usize) -> [f64; 2] {
+        let o = self.dofs.node_local[n];
+        [local[o], local[o + 1]]
+    }
+
+    /// Every contact pair evaluated at `local`.
+    pub fn contact_forces(&self, local: &[f64]) -> Vec<PairForce> {
+        let s = &self.setup;
+        s.contact
+            .iter()
+            .map(|c| {
+                pair_force(
+                    c,
+                    &s.bodies[c.body as usize],
+                    self.node_u(local, c.node as usize),
+                )
+            })
+            .collect()
+    }
+
+    /// The contact pairs of this increment.
+    pub fn contact_pairs(&self) -> &[ContactPair] {
+        &self.setup.contact
+    }
+
+    /// Updates the augmented multipliers from the solution `local`: λ ← max(0, λ − ε g).
+    /// `spacing` is each pair's node spacing, to report the penetration relative to it.
+    pub fn augment(&mut self, local: &[f64], spacing: &[f64]) -> Augmentation {
+        let forces = self.contact_forces(local);
+        let mut a = Augmentation::default();
+        for ((c, f), h) in self.setup.contact.iter_mut().zip(&forces).zip(spacing) {
+            a.change = a.change.max((f.pressure - c.multiplier).abs());
+            a.pressure = a.pressure.max(f.pressure);
+            a.penetration = a.penetration.max(-f.gap / h);
+            c.multiplier = f.pressure;
+        }
+        a
+    }
+
+    /// Adds the external forces of contact and surface pressure at `local` to `out` (owned,
+    /// free rows), with `sign` −1 for the residual.
+    fn external(&self, local: &[f64], mut add: impl FnMut(usize, usize, f64)) {
+        for (c, f) in self.setup.contact.iter().zip(self.contact_forces(local)) {
+            for (k, v) in f.force.iter().enumerate() {
+                add(c.node as usize, k, *v);
+            }
+        }
+        for (nodes, p) in &self.setup.surface {
+            let x = nodes.map(|n| self.node_position(local, n as usize));
+            let load = edge_pressure(x, *p);
+            for (j, &n) in nodes.iter().enumerate() {
+                for k in 0..2 {
+                    add(n as usize, k, load.force[2 * j + k]);
+                }
+            }
+        }
+    }
+
+    /// Current position of local node `n` (start of step plus the increment in `local`).
+    fn node_position(&self, local: &[f64], n: usize) -> [f64; 2] {
+        let u = self.node_u(local, n);
+        let x0 = self.node_start(n);
+        [x0[0] + u[0], x0[1] + u[1]]
+    }
+
+    /// Start-of-step position of local node `n` (an edge node at its chord's midpoint).
+    pub fn node_start(&self, n: usize) -> [f64; 2] {
+        let n_vertex = self.dofs.n_nodes() - self.dofs.edges.len();
+        if n < n_vertex {
+            self.mesh.points[self.dofs.node_point[n] as usize]
+        } else {
+            let [a, b] = self.dofs.edges[n - n_vertex].map(|p| self.mesh.points[p as usize]);
+            [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]
+        }
+    }
+
+    /// Whether component `c` of local node `n` is an owned, unconstrained row.
+    fn free(&self, n: usize, c: usize) -> bool {
+        self.dofs.node_owned[n] && self.setup.constraints.fixed[n][c].is_none()
+    }
+
     /// Reaction forces: the internal force on the constrained owned dofs of the nodes `select`
     /// picks, summed per component.
     pub fn reaction(&self, elems: &[ElementResult], select: impl Fn(usize) -> bool) -> [f64; 2] {
@@ -250,6 +350,46 @@ impl<'a> StepProblem<'a> {
     }
 }
 
+impl StepProblem<'_> {
+    /// −d(external force)/du of contact and surface pressure, on owned free rows, as
+    /// (global row, global column, value).
+    fn external_tangent(
+        &self,
+        local: &[f64],
+        mut add: impl FnMut(i32, i32, f64) -> Result<(), PetscError>,
+    ) -> Result<(), PetscError> {
+        let g = |n: usize, c: usize| (self.dofs.node_global[n] + c) as i32;
+        for (c, f) in self.setup.contact.iter().zip(self.contact_forces(local)) {
+            let n = c.node as usize;
+            for i in 0..2 {
+                if self.free(n, i) && f.pressure > 0.0 {
+                    for k in 0..2 {
+                        add(g(n, i), g(n, k), -f.tangent[i][k])?;
+                    }
+                }
+            }
+        }
+        for (nodes, p) in &self.setup.surface {
+            let x = nodes.map(|n| self.node_position(local, n as usize));
+            let load = edge_pressure(x, *p);
+            for (a, &na) in nodes.iter().enumerate() {
+                for i in 0..2 {
+                    if !self.free(na as usize, i) {
+                        continue;
+                    }
+                    for (b, &nb) in nodes.iter().enumerate() {
+                        for k in 0..2 {
+                            let v = -load.tangent[2 * a + i][2 * b + k];
+                            add(g(na as usize, i), g(nb as usize, k), v)?;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
 impl NonlinearProblem for StepProblem<'_> {
     fn residual(&mut self, x: VecRef, f: VecRef) -> Result<(), CallbackError> {
         let (local, elems) = self.evaluate(x)?;
@@ -263,6 +403,11 @@ impl NonlinearProblem for StepProblem<'_> {
                     }
                 }
             }
+            self.external(&local, |n, c, v| {
+                if self.free(n, c) {
+                    fa[self.dofs.node_global[n] - first + c] -= v;
+                }
+            });
             for &(n, force) in &self.setup.point_loads {
                 let n = n as usize;
                 for (c, fc) in force.iter().enumerate() {
@@ -287,7 +432,7 @@ impl NonlinearProblem for StepProblem<'_> {
     }
 
     fn jacobian(&mut self, x: VecRef, j: MatRef) -> Result<(), CallbackError> {
-        let (_, elems) = self.evaluate(x)?;
+        let (local, elems) = self.evaluate(x)?;
         let fatal = |e: PetscError| CallbackError::Fatal(e.to_string());
         let l2g = self.dofs.local_to_global();
         j.zero_entries().map_err(fatal)?;
@@ -311,6 +456,8 @@ impl NonlinearProblem for StepProblem<'_> {
                 j.add_values(&rows, &cols, &vals).map_err(fatal)?;
             }
         }
+        self.external_tangent(&local, |r, c, v| j.add_values(&[r], &[c], &[v]))
+            .map_err(fatal)?;
         for (n, fx) in self.setup.constraints.fixed.iter().enumerate() {
             if !self.dofs.node_owned[n] {
                 continue;

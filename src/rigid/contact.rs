@@ -1,0 +1,178 @@
+//! Node-to-rigid-surface contact by penalty with augmentation (Uzawa), frictionless or with
+//! the interface shear limited to α·cu.
+//!
+//! Each soil boundary node carries a weight: its share of the boundary length by Simpson's rule
+//! on the P2 edges (L/6, 4L/6, L/6), so equal node pressures are the consistent nodal forces of
+//! a uniform traction and a flat punch on a homogeneous block gives the exact uniform pressure.
+//! The normal pressure is p = max(0, λ − ε_N g) with g the signed distance of the node to the
+//! body at the end of the increment and λ the augmented multiplier; after Newton converges,
+//! λ ← p until the multipliers settle, so the penetration vanishes however soft the penalty.
+//! The shear τ is a stick penalty on the tangential slip of the increment, returned to ±α·cu
+//! when it exceeds it.
+
+use super::shape::Shape;
+
+/// One soil node facing one rigid body in an increment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactPair {
+    /// Local node index.
+    pub node: u32,
+    /// Index of the rigid body.
+    pub body: u32,
+    /// Node position at the start of the increment.
+    pub start: [f64; 2],
+    /// Boundary length the node stands for (m per metre).
+    pub weight: f64,
+    /// Normal and tangential penalty (Pa/m).
+    pub penalty: f64,
+    /// Augmented normal pressure (Pa), updated between Newton solves.
+    pub multiplier: f64,
+    /// Shear stress at the start of the increment (Pa), along t = (−n_y, n_x).
+    pub shear_start: f64,
+    /// α·cu (Pa); 0 = frictionless.
+    pub shear_limit: f64,
+    /// The body's displacement over the increment.
+    pub body_increment: [f64; 2],
+}
+
+/// Force of the body on the node, its derivative and the interface state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairForce {
+    /// Force on the node (N per metre).
+    pub force: [f64; 2],
+    /// d force / d u, row-major.
+    pub tangent: [[f64; 2]; 2],
+    /// Normal pressure (Pa), >= 0.
+    pub pressure: f64,
+    /// Shear stress along t (Pa).
+    pub shear: f64,
+    /// Signed distance to the body (m), negative inside.
+    pub gap: f64,
+}
+
+/// Evaluates the pair at the node's increment displacement `u`, against `shape` (the body at the
+/// end of the increment).
+pub fn pair_force(pair: &ContactPair, shape: &Shape, u: [f64; 2]) -> PairForce {
+    let x = [pair.start[0] + u[0], pair.start[1] + u[1]];
+    let prox = shape.closest(x);
+    let n = prox.normal;
+    let t = [-n[1], n[0]];
+    let kappa = prox.curvature;
+    let eps = pair.penalty;
+    let p = pair.multiplier - eps * prox.distance;
+    let none = PairForce {
+        force: [0.0; 2],
+        tangent: [[0.0; 2]; 2],
+        pressure: 0.0,
+        shear: 0.0,
+        gap: prox.distance,
+    };
+    if p <= 0.0 {
+        return none;
+    }
+    // Slip of the node relative to the body over the increment, along the current tangent.
+    let d = [u[0] - pair.body_increment[0], u[1] - pair.body_increment[1]];
+    let (mut tau, mut dtau) = (0.0, 0.0);
+    if pair.shear_limit > 0.0 {
+        let slip = d[0] * t[0] + d[1] * t[1];
+        let trial = pair.shear_start + eps * slip;
+        if trial.abs() <= pair.shear_limit {
+            tau = trial;
+            dtau = eps * (1.0 - kappa * (d[0] * n[0] + d[1] * n[1]));
+        } else {
+            tau = pair.shear_limit * trial.signum();
+        }
+    }
+    let w = pair.weight;
+    let force = [w * (p * n[0] - tau * t[0]), w * (p * n[1] - tau * t[1])];
+    // d(p n)/dx = −ε n nᵀ + p κ t tᵀ;  d(τ t)/dx = dτ t tᵀ − τ κ n tᵀ.
+    let tangent = std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            w * (-eps * n[i] * n[j] + p * kappa * t[i] * t[j] - dtau * t[i] * t[j]
+                + tau * kappa * n[i] * t[j])
+        })
+    });
+    PairForce {
+        force,
+        tangent,
+        pressure: p,
+        shear: tau,
+        gap: prox.distance,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pair(shear_limit: f64, shear_start: f64) -> ContactPair {
+        ContactPair {
+            node: 0,
+            body: 0,
+            start: [0.3, -1.02],
+            weight: 0.05,
+            penalty: 1e6,
+            multiplier: 2e3,
+            shear_start,
+            shear_limit,
+            body_increment: [0.001, -0.002],
+        }
+    }
+
+    fn check_tangent(pair: &ContactPair, shape: &Shape, u: [f64; 2]) {
+        let f = pair_force(pair, shape, u);
+        let h = 1e-7;
+        for j in 0..2 {
+            let mut up = u;
+            let mut um = u;
+            up[j] += h;
+            um[j] -= h;
+            let (fp, fm) = (pair_force(pair, shape, up), pair_force(pair, shape, um));
+            for i in 0..2 {
+                let fd = (fp.force[i] - fm.force[i]) / (2.0 * h);
+                let scale = f
+                    .tangent
+                    .iter()
+                    .flatten()
+                    .fold(1e-12_f64, |m, v| m.max(v.abs()));
+                assert!(
+                    (fd - f.tangent[i][j]).abs() < 1e-6 * scale,
+                    "d f{i}/d u{j}: analytic {} finite difference {fd}",
+                    f.tangent[i][j]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn tangents_match_finite_differences() {
+        let circle = Shape::circle([0.0, 0.0], 1.0).unwrap();
+        let u = [0.002, 0.003];
+        // Frictionless, stick and slip, on a curved surface.
+        check_tangent(&pair(0.0, 0.0), &circle, u);
+        check_tangent(&pair(1e9, 100.0), &circle, u);
+        check_tangent(&pair(500.0, 450.0), &circle, u);
+        let square =
+            Shape::polygon(&[[-1.0, -2.0], [1.0, -2.0], [1.0, -1.0], [-1.0, -1.0]], 0.0).unwrap();
+        let mut p = pair(1e9, -30.0);
+        p.start = [0.2, -0.99];
+        check_tangent(&p, &square, u);
+    }
+
+    #[test]
+    fn frictionless_force_is_normal_and_shear_is_capped() {
+        let circle = Shape::circle([0.0, 0.0], 1.0).unwrap();
+        let f = pair_force(&pair(0.0, 0.0), &circle, [0.01, 0.0]);
+        let x = [0.31, -1.02];
+        let cross = f.force[0] * x[1] - f.force[1] * x[0];
+        assert!(cross.abs() < 1e-12 * f.force[0].abs().max(f.force[1].abs()));
+        assert_eq!(f.shear, 0.0);
+        let f = pair_force(&pair(500.0, 450.0), &circle, [0.05, 0.0]);
+        assert_eq!(f.shear.abs(), 500.0);
+        // Far from the body: no force.
+        let mut away = pair(0.0, 0.0);
+        away.start = [2.0, 2.0];
+        away.multiplier = 0.0;
+        assert_eq!(pair_force(&away, &circle, [0.0; 2]).force, [0.0; 2]);
+    }
+}

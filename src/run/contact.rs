@@ -1,0 +1,199 @@
+//! Contact and surface pressure of an increment: found afresh on the mesh after every remesh,
+//! with the contact state carried across it by node identity.
+
+use super::step::edge_key;
+use super::Simulation;
+use crate::fem::surface_load::simpson_weights;
+use crate::mesh::LocalMesh;
+use crate::rigid::{ContactPair, Shape};
+use crate::solve::DofMap;
+use std::collections::HashMap;
+
+/// Contact pairs with each pair's node spacing, the bodies at the end of the increment, and the
+/// surface-pressure edges.
+pub(super) struct BoundaryLoads {
+    pub pairs: Vec<ContactPair>,
+    pub spacing: Vec<f64>,
+    pub bodies: Vec<Shape>,
+    pub surface: Vec<([u32; 3], f64)>,
+}
+
+/// Contact state kept per node between increments: (node key, body) → (pressure, shear).
+pub(super) type ContactState = HashMap<([u64; 2], u32), [f64; 2]>;
+
+impl Simulation {
+    /// Rank-local. Boundary nodes near each rigid body become contact pairs (owned nodes only;
+    /// the search looks only inside each body's box grown by the search margin), and boundary
+    /// edges whose ends started inside a `[[surface_pressure]]` region carry its pressure.
+    pub(super) fn boundary_loads(
+        &self,
+        mesh: &LocalMesh,
+        dofs: &DofMap,
+        from: f64,
+        to: f64,
+    ) -> BoundaryLoads {
+        let model = &self.model;
+        let bodies: Vec<Shape> = model.bodies.iter().map(|b| b.shape(to)).collect();
+        let mut out = BoundaryLoads {
+            pairs: Vec::new(),
+            spacing: Vec::new(),
+            bodies,
+            surface: Vec::new(),
+        };
+        if model.bodies.is_empty() && model.scene.surface_pressure.is_empty() {
+            return out;
+        }
+        let n_vertex = dofs.n_nodes() - dofs.edges.len();
+        let edge_node: HashMap<(u32, u32), u32> = dofs
+            .edges
+            .iter()
+            .enumerate()
+            .map(|(i, e)| ((e[0], e[1]), (n_vertex + i) as u32))
+            .collect();
+        let mut weight: HashMap<u32, f64> = HashMap::new();
+        for e in &mesh.boundary_edges {
+            let [a, b] = *e;
+            let (ga, gb) = (mesh.gids[a as usize], mesh.gids[b as usize]);
+            let pair = if ga < gb { (a, b) } else { (b, a) };
+            let Some(&m) = edge_node.get(&pair) else {
+                continue;
+            };
+            let na = dofs.node_of_point[a as usize];
+            let nb = dofs.node_of_point[b as usize];
+            let (xa, xb) = (mesh.points[a as usize], mesh.points[b as usize]);
+            let len = ((xb[0] - xa[0]).powi(2) + (xb[1] - xa[1]).powi(2)).sqrt();
+            let w = simpson_weights(len);
+            for (node, wk) in [na, m, nb].into_iter().zip(w) {
+                *weight.entry(node).or_default() += wk;
+            }
+            for sp in &model.scene.surface_pressure {
+                let inside = |p: u32| {
+                    sp.region
+                        .matches(self.reference_position(mesh, p as usize), model.tol)
+                };
+                if inside(a) && inside(b) {
+                    out.surface.push(([na, m, nb], sp.pressure));
+                }
+            }
+        }
+        if model.bodies.is_empty() {
+            return out;
+        }
+        let young = model.scene.material.young;
+        let state = self.last_contact.borrow();
+        let mut nodes: Vec<(u32, f64)> = weight
+            .into_iter()
+            .filter(|(n, _)| dofs.node_owned[*n as usize])
+            .collect();
+        nodes.sort_unstable_by_key(|(n, _)| *n);
+        for (bi, body) in model.bodies.iter().enumerate() {
+            let shape = &out.bodies[bi];
+            let d0 = body.displacement(from);
+            let d1 = body.displacement(to);
+            let inc = [d1[0] - d0[0], d1[1] - d0[1]];
+            let moved = inc[0].hypot(inc[1]);
+            let bb = shape.bounding_box();
+            for &(n, w) in &nodes {
+                let (x, h, key) = node_info(mesh, dofs, n as usize, n_vertex);
+                let margin = 2.0 * h + moved;
+                let outside_box = x[0] < bb[0][0] - margin
+                    || x[0] > bb[1][0] + margin
+                    || x[1] < bb[0][1] - margin
+                    || x[1] > bb[1][1] + margin;
+                if outside_box || shape.closest(x).distance > margin {
+                    continue;
+                }
+                let carried = state.get(&(key, bi as u32)).copied().unwrap_or_else(|| {
+                    // A new edge node starts from the mean of its ends.
+                    let [a, b] = key;
+                    let ends = [
+                        state.get(&([a, a], bi as u32)),
+                        state.get(&([b, b], bi as u32)),
+                    ];
+                    let v: Vec<[f64; 2]> = ends.into_iter().flatten().copied().collect();
+                    if a == b || v.is_empty() {
+                        [0.0; 2]
+                    } else {
+                        let k = v.len() as f64;
+                        [
+                            v.iter().map(|s| s[0]).sum::<f64>() / k,
+                            v.iter().map(|s| s[1]).sum::<f64>() / k,
+                        ]
+                    }
+                });
+                out.pairs.push(ContactPair {
+                    node: n,
+                    body: bi as u32,
+                    start: x,
+                    weight: w,
+                    penalty: model.scene.contact.penalty * young / h,
+                    multiplier: carried[0],
+                    shear_start: carried[1],
+                    shear_limit: body.shear_limit,
+                    body_increment: inc,
+                });
+                out.spacing.push(h);
+            }
+        }
+        out
+    }
+}
+
+/// A particle inside a rigid body by more than this fraction of its spacing ends the run.
+pub const PENETRATION_LIMIT: f64 = 0.5;
+
+impl Simulation {
+    /// Collective. The deepest penetration of a particle into a rigid body, as a fraction of
+    /// its spacing (0 when none), and an error when it passes [`PENETRATION_LIMIT`]: the soil
+    /// has passed through the body.
+    pub(super) fn check_penetration(&self, world: &pfem_partition::Comm) -> Result<f64, String> {
+        if self.model.bodies.is_empty() {
+            return Ok(0.0);
+        }
+        let lambda = self.header.load_factor;
+        let mut worst: Option<(f64, u64, usize)> = None;
+        for (bi, body) in self.model.bodies.iter().enumerate() {
+            let shape = body.shape(lambda);
+            for i in 0..self.particles.len() {
+                let depth =
+                    -shape.closest(self.particles.position[i]).distance / self.particles.h[i];
+                if worst.is_none_or(|w| depth > w.0) {
+                    worst = Some((depth, self.particles.gid[i], bi));
+                }
+            }
+        }
+        let local = worst.map_or(0.0, |w| w.0.max(0.0));
+        let deepest = pfem_partition::max_f64(world, local);
+        let message = worst.filter(|w| w.0 > PENETRATION_LIMIT).map(|(d, gid, bi)| {
+            format!(
+                "step {}: particle {gid} is inside rigid body '{}' by {d:.3} of its spacing                  (limit {PENETRATION_LIMIT}): the soil passed through the body; try a larger                  contact.penalty or more steps",
+                self.header.step, self.model.bodies[bi].name
+            )
+        });
+        match pfem_partition::agree_on_error(world, message) {
+            Some(e) => Err(e),
+            None => Ok(deepest),
+        }
+    }
+}
+
+/// Start position, spacing and global key of local node `n`.
+fn node_info(
+    mesh: &LocalMesh,
+    dofs: &DofMap,
+    n: usize,
+    n_vertex: usize,
+) -> ([f64; 2], f64, [u64; 2]) {
+    if n < n_vertex {
+        let p = dofs.node_point[n] as usize;
+        (mesh.points[p], mesh.h[p], [mesh.gids[p]; 2])
+    } else {
+        let [a, b] = dofs.edges[n - n_vertex].map(|p| p as usize);
+        let (xa, xb) = (mesh.points[a], mesh.points[b]);
+        (
+            [0.5 * (xa[0] + xb[0]), 0.5 * (xa[1] + xb[1])],
+            mesh.h[a].max(mesh.h[b]),
+            edge_key(mesh.gids[a], mesh.gids[b]),
+        )
+    }
+}

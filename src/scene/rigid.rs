@@ -1,0 +1,295 @@
+//! Scene tables for rigid bodies pushed into the soil, their contact, surface pressure and the
+//! geostatic initial stress (`[[rigid]]`, `[contact]`, `[[surface_pressure]]`, `[geostatic]`),
+//! and the named measurements `history.csv` records (`[[probe]]`, `[[history.columns]]`).
+
+use serde::{Deserialize, Serialize};
+
+use super::selector::Selector;
+
+/// `[[rigid]]`: a rigid, convex body moved by stages. Exactly one of `circle` and `polygon`.
+///
+/// ```toml
+/// [[rigid]]
+/// name = "pipe"
+/// circle = { centre = [0.24, 0.22], radius = 0.02 }
+/// stages = [ { to = [0.0, -0.02], steps = 50 }, { to = [0.08, -0.02], steps = 200 } ]
+/// adhesion = 0.0
+/// ```
+///
+/// A half model (symmetry plane through the body) gives the whole shape: the soil lies on one
+/// side of the plane, so only that half is ever touched, and the body's force is the half
+/// model's (a history column's `scale` doubles it for the whole body).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Rigid {
+    /// Name used by history measures (`rigid.NAME.fy`), unique among the bodies.
+    pub name: String,
+    /// A circle: `{ centre = [x, y], radius = r }` (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub circle: Option<Circle>,
+    /// A convex polygon, optionally with rounded corners: `{ vertices = [[x, y], ...],
+    /// corner_radius = 0.0 }` (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polygon: Option<Polygon>,
+    /// The motion: each stage moves the body linearly, over `steps` steps, to the displacement
+    /// `to` (m, from the initial position). The body holds still after its last stage; the
+    /// scene's step count is the longest body's stage total. Default: no motion.
+    #[serde(default)]
+    pub stages: Vec<Stage>,
+    /// Interface adhesion factor α, 0 <= α <= 1: the interface shear stress is limited to
+    /// α·cu (stick below, slip at the limit). 0 = smooth (default), 1 = fully rough.
+    #[serde(default)]
+    pub adhesion: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Circle {
+    pub centre: [f64; 2],
+    pub radius: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Polygon {
+    /// Corners of the convex polygon (either orientation), at least 3.
+    pub vertices: Vec<[f64; 2]>,
+    /// Radius of the rounded corners (m), default 0 (sharp).
+    #[serde(default)]
+    pub corner_radius: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Stage {
+    /// Displacement of the body from its initial position at the end of the stage (m).
+    pub to: [f64; 2],
+    /// Steps the stage takes, >= 1.
+    pub steps: u32,
+}
+
+/// `[contact]`: the penalty method with augmentation shared by every rigid body.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Contact {
+    /// Normal and tangential penalty stiffness as a multiple of E/h (h the spacing at the
+    /// node). Default 1000.
+    pub penalty: f64,
+    /// Augmentations end when no contact node's penetration exceeds this fraction of its
+    /// spacing and the contact pressures changed by less than `tolerance` relative in the last
+    /// augmentation. Default 1e-6.
+    pub tolerance: f64,
+    /// Most Newton solves per increment (the first plus augmentations). Default 12.
+    pub max_augmentations: u32,
+}
+
+impl Default for Contact {
+    fn default() -> Self {
+        Contact {
+            penalty: 1000.0,
+            tolerance: 1e-6,
+            max_augmentations: 12,
+        }
+    }
+}
+
+/// `[[surface_pressure]]`: a uniform pressure (compression positive) on the boundary edges
+/// whose two end particles started in `where`, found again after every remesh and following
+/// the edges as they move (a follower load). Constant over the run: with `[geostatic]` the
+/// surcharge is in equilibrium from step 1.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfacePressure {
+    #[serde(rename = "where")]
+    pub region: Selector,
+    /// Pa.
+    pub pressure: f64,
+}
+
+/// `[geostatic]`: the initial stress of a level ground: vertical σ_v = −(surcharge + γ·(surface
+/// − y)) with γ = density·|g|, horizontal and out-of-plane K0·σ_v (compression negative).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Geostatic {
+    /// Level of the ground surface (m).
+    pub surface: f64,
+    /// Pressure on the surface (Pa), default 0; pair it with a `[[surface_pressure]]`.
+    #[serde(default)]
+    pub surcharge: f64,
+    /// Coefficient of earth pressure at rest, default 1.
+    #[serde(default = "one")]
+    pub k0: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// `[[probe]]`: a particle whose displacement history measures read (`probe.NAME.ux`): the one
+/// nearest to `at` when the case is created, like a point load's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Probe {
+    pub name: String,
+    pub at: [f64; 2],
+}
+
+/// `[[history.columns]]`: one column of `history.csv`, `scale * measure`.
+///
+/// Measures: `load_factor`, `time`, `area` (body area, m²), `probe.NAME.ux|uy`,
+/// `rigid.NAME.ux|uy` (the body's displacement), `rigid.NAME.fx|fy` (the force the soil puts on
+/// the body: the sum of the contact tractions, N/m), `reaction.NAME.fx|fy` (the force on the
+/// particles of a named `[[fixed]]` or `[[prescribed]]` set).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Column {
+    pub name: String,
+    pub measure: String,
+    /// Default 1.
+    #[serde(default = "one")]
+    pub scale: f64,
+    /// Horizontal reference lines drawn on the plot of this column: `[{ value = 9.142,
+    /// label = "exact" }]`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub reference: Vec<ReferenceLine>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceLine {
+    pub value: f64,
+    pub label: String,
+}
+
+/// A parsed history measure.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Measure {
+    LoadFactor,
+    Time,
+    Area,
+    Probe(String, usize),
+    RigidDisplacement(String, usize),
+    RigidForce(String, usize),
+    Reaction(String, usize),
+}
+
+impl Measure {
+    pub fn parse(text: &str) -> Result<Measure, String> {
+        let comp = |c: &str, a: &str, b: &str| match c {
+            _ if c == a => Some(0),
+            _ if c == b => Some(1),
+            _ => None,
+        };
+        let parts: Vec<&str> = text.split('.').collect();
+        let bad = || {
+            format!(
+                "unknown measure \"{text}\" (expected load_factor, time, area, probe.NAME.ux|uy, \
+                 rigid.NAME.ux|uy|fx|fy or reaction.NAME.fx|fy)"
+            )
+        };
+        match parts.as_slice() {
+            ["load_factor"] => Ok(Measure::LoadFactor),
+            ["time"] => Ok(Measure::Time),
+            ["area"] => Ok(Measure::Area),
+            ["probe", n, c] => comp(c, "ux", "uy")
+                .map(|i| Measure::Probe(n.to_string(), i))
+                .ok_or_else(bad),
+            ["rigid", n, c] => match (comp(c, "ux", "uy"), comp(c, "fx", "fy")) {
+                (Some(i), _) => Ok(Measure::RigidDisplacement(n.to_string(), i)),
+                (_, Some(i)) => Ok(Measure::RigidForce(n.to_string(), i)),
+                _ => Err(bad()),
+            },
+            ["reaction", n, c] => comp(c, "fx", "fy")
+                .map(|i| Measure::Reaction(n.to_string(), i))
+                .ok_or_else(bad),
+            _ => Err(bad()),
+        }
+    }
+}
+
+impl Rigid {
+    /// Steps of all stages.
+    pub fn stage_steps(&self) -> u64 {
+        self.stages.iter().map(|s| s.steps as u64).sum()
+    }
+
+    /// Displacement of the body after `step` steps (fractional within a step: linear).
+    pub fn displacement_at(&self, step: f64) -> [f64; 2] {
+        let mut from = [0.0; 2];
+        let mut start = 0.0;
+        for s in &self.stages {
+            let end = start + s.steps as f64;
+            if step <= end {
+                let t = ((step - start) / s.steps as f64).clamp(0.0, 1.0);
+                return [
+                    from[0] + t * (s.to[0] - from[0]),
+                    from[1] + t * (s.to[1] - from[1]),
+                ];
+            }
+            from = s.to;
+            start = end;
+        }
+        from
+    }
+
+    /// Index of the stage running during step `step` (1-based step), or the number of stages
+    /// once all are done.
+    pub fn stage_of(&self, step: u64) -> usize {
+        let mut end = 0;
+        for (i, s) in self.stages.iter().enumerate() {
+            end += s.steps as u64;
+            if step <= end {
+                return i;
+            }
+        }
+        self.stages.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stages_are_reached_linearly_and_held() {
+        let r = Rigid {
+            name: "pipe".into(),
+            circle: None,
+            polygon: None,
+            stages: vec![
+                Stage {
+                    to: [0.0, -0.02],
+                    steps: 50,
+                },
+                Stage {
+                    to: [0.08, -0.02],
+                    steps: 200,
+                },
+            ],
+            adhesion: 0.0,
+        };
+        assert_eq!(r.stage_steps(), 250);
+        assert_eq!(r.displacement_at(25.0), [0.0, -0.01]);
+        assert_eq!(r.displacement_at(50.0), [0.0, -0.02]);
+        let d = r.displacement_at(150.0);
+        assert!((d[0] - 0.04).abs() < 1e-15 && d[1] == -0.02);
+        assert_eq!(r.displacement_at(300.0), [0.08, -0.02]);
+        assert_eq!(r.stage_of(50), 0);
+        assert_eq!(r.stage_of(51), 1);
+        assert_eq!(r.stage_of(251), 2);
+    }
+
+    #[test]
+    fn measures_parse() {
+        assert_eq!(
+            Measure::parse("rigid.tbar.fy"),
+            Ok(Measure::RigidForce("tbar".into(), 1))
+        );
+        assert_eq!(
+            Measure::parse("probe.tip.ux"),
+            Ok(Measure::Probe("tip".into(), 0))
+        );
+        assert!(Measure::parse("rigid.tbar.fz").is_err());
+        assert!(Measure::parse("force").is_err());
+    }
+}

@@ -1,0 +1,224 @@
+//! Checks of the rigid-body, contact, load and history tables (see `rigid.rs`).
+
+use std::collections::HashSet;
+
+use super::field_path::FieldPath;
+use super::rigid::Measure;
+use super::schema::{MaterialModel, Scene};
+use super::validate::Invalid;
+use crate::rigid::shape::Shape;
+
+fn fail<T>(path: FieldPath, message: String) -> Result<T, Invalid> {
+    Err((path, message))
+}
+
+fn finite_positive(path: FieldPath, x: f64) -> Result<(), Invalid> {
+    if x > 0.0 && x.is_finite() {
+        Ok(())
+    } else {
+        fail(path, format!("must be > 0 (got {x})"))
+    }
+}
+
+/// The longest stage total of the rigid bodies (0 without stages).
+pub fn stage_total(s: &Scene) -> u64 {
+    s.rigid.iter().map(|r| r.stage_steps()).max().unwrap_or(0)
+}
+
+/// The shape of `[[rigid]]` entry `i` at its initial position.
+pub fn shape_of(s: &Scene, i: usize) -> Result<Shape, Invalid> {
+    let r = &s.rigid[i];
+    let path = FieldPath::key("rigid").at(i);
+    match (&r.circle, &r.polygon) {
+        (Some(c), None) => Shape::circle(c.centre, c.radius).map_err(|e| (path.join("circle"), e)),
+        (None, Some(p)) => {
+            Shape::polygon(&p.vertices, p.corner_radius).map_err(|e| (path.join("polygon"), e))
+        }
+        _ => fail(
+            path,
+            "needs exactly one shape: `circle = { centre, radius }` or `polygon = { vertices, \
+             corner_radius }`"
+                .to_string(),
+        ),
+    }
+}
+
+pub fn check(s: &Scene) -> Result<(), Invalid> {
+    let mut names = HashSet::new();
+    for (i, r) in s.rigid.iter().enumerate() {
+        let path = FieldPath::key("rigid").at(i);
+        if r.name.trim().is_empty() || r.name.contains('.') {
+            return fail(
+                path.join("name"),
+                format!("must be a non-empty name without dots (got {:?})", r.name),
+            );
+        }
+        if !names.insert(r.name.clone()) {
+            return fail(path.join("name"), format!("\"{}\" is used twice", r.name));
+        }
+        shape_of(s, i)?;
+        for (k, st) in r.stages.iter().enumerate() {
+            let sp = path.join("stages").at(k);
+            if !st.to.iter().all(|x| x.is_finite()) {
+                return fail(sp.join("to"), format!("must be finite (got {:?})", st.to));
+            }
+            if st.steps < 1 {
+                return fail(sp.join("steps"), "must be >= 1 (got 0)".to_string());
+            }
+        }
+        if !(0.0..=1.0).contains(&r.adhesion) {
+            return fail(
+                path.join("adhesion"),
+                format!("must be in [0, 1] (got {})", r.adhesion),
+            );
+        }
+        if r.adhesion > 0.0 && s.material.model != MaterialModel::Tresca {
+            return fail(
+                path.join("adhesion"),
+                "limits the interface shear to adhesion * material.cu, which needs model = \
+                 \"tresca\""
+                    .to_string(),
+            );
+        }
+    }
+    let c = FieldPath::key("contact");
+    finite_positive(c.join("penalty"), s.contact.penalty)?;
+    if !(s.contact.tolerance > 0.0 && s.contact.tolerance < 1.0) {
+        return fail(
+            c.join("tolerance"),
+            format!("must be > 0 and < 1 (got {})", s.contact.tolerance),
+        );
+    }
+    if s.contact.max_augmentations < 1 {
+        return fail(
+            c.join("max_augmentations"),
+            "must be >= 1 (got 0)".to_string(),
+        );
+    }
+    for (i, p) in s.surface_pressure.iter().enumerate() {
+        if !p.pressure.is_finite() {
+            return fail(
+                FieldPath::key("surface_pressure").at(i).join("pressure"),
+                format!("must be finite (got {})", p.pressure),
+            );
+        }
+    }
+    if let Some(g) = &s.geostatic {
+        let path = FieldPath::key("geostatic");
+        if !g.surface.is_finite() {
+            return fail(
+                path.join("surface"),
+                format!("must be finite (got {})", g.surface),
+            );
+        }
+        if !(g.surcharge >= 0.0 && g.surcharge.is_finite()) {
+            return fail(
+                path.join("surcharge"),
+                format!("must be >= 0 (got {})", g.surcharge),
+            );
+        }
+        if !(g.k0 > 0.0 && g.k0.is_finite()) {
+            return fail(path.join("k0"), format!("must be > 0 (got {})", g.k0));
+        }
+    }
+    let mut probes = HashSet::new();
+    for (i, p) in s.probe.iter().enumerate() {
+        let path = FieldPath::key("probe").at(i);
+        if p.name.trim().is_empty() || p.name.contains('.') || !probes.insert(p.name.clone()) {
+            return fail(
+                path.join("name"),
+                format!("must be a unique name without dots (got {:?})", p.name),
+            );
+        }
+        if !p.at.iter().all(|x| x.is_finite()) {
+            return fail(path.join("at"), format!("must be finite (got {:?})", p.at));
+        }
+    }
+    let total = stage_total(s);
+    let count = FieldPath::key("steps").join("count");
+    if total > 0 && s.steps.count as u64 != total {
+        return fail(
+            count,
+            format!(
+                "is {} but the [[rigid]] stages take {total} steps; leave it out or make them \
+                 agree",
+                s.steps.count
+            ),
+        );
+    }
+    check_history(s)
+}
+
+fn check_history(s: &Scene) -> Result<(), Invalid> {
+    let h = FieldPath::key("history");
+    if s.history.kind.is_none() && s.history.columns.is_empty() {
+        return fail(
+            h,
+            "needs `kind` or at least one [[history.columns]] entry".to_string(),
+        );
+    }
+    let set_names: Vec<&String> = s
+        .fixed
+        .iter()
+        .filter_map(|f| f.name.as_ref())
+        .chain(s.prescribed.iter().filter_map(|p| p.name.as_ref()))
+        .collect();
+    let mut seen: HashSet<String> = match s.history.kind {
+        Some(k) => crate::history::columns(k)
+            .iter()
+            .map(|c| c.to_string())
+            .collect(),
+        None => ["step".to_string()].into(),
+    };
+    for (i, c) in s.history.columns.iter().enumerate() {
+        let path = h.join("columns").at(i);
+        let bad_name = c.name.is_empty()
+            || !c
+                .name
+                .chars()
+                .all(|ch| ch.is_ascii_alphanumeric() || ch == '_');
+        if bad_name || !seen.insert(c.name.clone()) {
+            return fail(
+                path.join("name"),
+                format!(
+                    "must be a unique column name of letters, digits and _ (got {:?})",
+                    c.name
+                ),
+            );
+        }
+        if !c.scale.is_finite() {
+            return fail(
+                path.join("scale"),
+                format!("must be finite (got {})", c.scale),
+            );
+        }
+        let m = Measure::parse(&c.measure).map_err(|e| (path.join("measure"), e))?;
+        let known = match &m {
+            Measure::Probe(n, _) => s.probe.iter().any(|p| &p.name == n),
+            Measure::RigidDisplacement(n, _) | Measure::RigidForce(n, _) => {
+                s.rigid.iter().any(|r| &r.name == n)
+            }
+            Measure::Reaction(n, _) => set_names.contains(&n),
+            _ => true,
+        };
+        if !known {
+            return fail(
+                path.join("measure"),
+                format!(
+                    "\"{}\" names no [[probe]], [[rigid]] or named [[fixed]]/[[prescribed]] entry",
+                    c.measure
+                ),
+            );
+        }
+    }
+    let mut sets = HashSet::new();
+    for n in set_names {
+        if !sets.insert(n) {
+            return fail(
+                h,
+                format!("the [[fixed]]/[[prescribed]] name \"{n}\" is used twice"),
+            );
+        }
+    }
+    Ok(())
+}
