@@ -1,14 +1,21 @@
 //! PNG pictures of a run's output folder `DIR` (`pfem-mpi plot DIR`), written to `DIR/plots/`:
 //!
-//! - `history.png`, from `DIR/history.csv`: the load–displacement curve(s) of the scene kind
-//!   (told by the file's columns) with the reference solutions of `shared/reference.md`:
+//! - `history.png`, from `DIR/history.csv` and the run's scene `DIR/scene.toml` (when the run
+//!   wrote one). A legacy history kind gets its fixed picture, with the reference solutions of
+//!   `shared/reference.md`, when the header is that kind's and the scene asked for the kind (or
+//!   there is no `scene.toml`: runs from before it was written):
 //!   - cantilever: u/L and v/L against λ = P L²/(E I), with the Bisshopp–Drucker elastica
 //!     (dashed) and the plane-strain Reissner beam at λ = 2, 5, 10 (crosses);
 //!   - footing: q/cu against z/B, with Prandtl's 2 + π and the deep smooth-strip limit 2 + 2π;
 //!   - block: stress/cu against strain with the Tresca strength 2, above the volume ratio
 //!     against strain with the isochoric 1.
 //!
-//!   The picture is [`CURVE_SIZE`], or [`BLOCK_SIZE`] for a block.
+//!   The picture is [`CURVE_SIZE`], or [`BLOCK_SIZE`] for a block. Any other history (a scene's
+//!   `[[history.columns]]`) is drawn column by column: x is the first column after `step` when it
+//!   strictly rises or falls over the run, otherwise `step` (a pipeline's depth holds while it
+//!   moves sideways); one panel per other column, stacked, with the reference lines the scene
+//!   declares for that column (dashed, labelled in the legend; none without `scene.toml`),
+//!   axes named by the columns. The picture is [`declared_size`] for its number of panels.
 //! - `FIELD.png` for `FIELD` = `eps_q`, `sigma_yy`, `tau_xy` (and `incremental_displacement`,
 //!   as its length, when the frame has it), when `DIR/fields.xdmf` lists a frame: the field on
 //!   the deformed mesh of the last frame, interpolated linearly in each triangle, axes in metres
@@ -20,33 +27,40 @@
 
 mod colour_map;
 mod contour;
-mod curves;
+mod declared;
 mod error;
 mod font;
 mod frame;
 mod history;
+mod history_picture;
+mod legacy;
 mod numbers;
+mod panel;
 mod picture;
 mod reference;
+mod scene_file;
 
 use std::path::{Path, PathBuf};
 
 pub use colour_map::colour_map;
 pub use contour::{COLOUR_BAR_WIDTH, CONTOUR_SIZE};
-pub use curves::{BLOCK_SIZE, CURVE_SIZE};
+pub use declared::{declared_size, PANEL_HEIGHT};
 pub use error::PlotError;
+pub use legacy::{BLOCK_SIZE, CURVE_SIZE};
 
-/// Writes `DIR/plots/*.png`: the load–displacement curve(s) of the scene kind with reference
-/// lines, and contour pictures of eps_q, sigma_yy, tau_xy on the deformed mesh of the last
-/// frame (if `DIR/fields.xdmf` exists and lists a frame); see the module documentation.
-/// Returns the files written, history first.
+/// Writes `DIR/plots/*.png`: the history's curve(s) with reference lines (a legacy kind's, or
+/// the scene's declared columns' from `DIR/scene.toml`), and contour pictures of eps_q,
+/// sigma_yy, tau_xy on the deformed mesh of the last frame (if `DIR/fields.xdmf` exists and
+/// lists a frame); see the module documentation. Returns the files written, history first.
 ///
 /// All inputs are read before any picture is written. Errors name the file at fault: a missing
 /// or malformed `history.csv`, a damaged `fields.xdmf`, a frame file that cannot be read or
-/// lacks a field, or a picture that cannot be written.
+/// lacks a field, or a picture that cannot be written. A `scene.toml` that cannot be read or
+/// parsed is no error: a warning on stderr, and the history is drawn as without one.
 pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
     font::register()?;
     let history = history::read(&dir.join("history.csv"))?;
+    let scene = scene_file::read(dir);
     let frame = frame::last_frame(dir)?;
     let mut fields = Vec::new();
     if let Some(frame) = &frame {
@@ -69,7 +83,7 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
         .map_err(|e| PlotError::new(&out, format!("cannot create folder: {e}")))?;
     let mut written = Vec::new();
     let path = out.join("history.png");
-    curves::draw(&history, &path)?;
+    history_picture::draw(&history, scene.as_ref(), &path)?;
     written.push(path);
     if let Some(frame) = &frame {
         let when = match frame.time {

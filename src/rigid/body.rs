@@ -10,6 +10,8 @@ pub struct RigidBody {
     pub initial: Shape,
     /// Largest interface shear stress (Pa): adhesion * cu; 0 for a smooth body.
     pub shear_limit: f64,
+    /// Suction the interface carries before it separates (Pa, >= 0).
+    pub suction: f64,
     motion: Rigid,
     /// Steps of the whole run: load factor 1 is the end of the last step.
     steps: f64,
@@ -21,6 +23,7 @@ impl RigidBody {
             name: spec.name.clone(),
             initial,
             shear_limit: spec.adhesion * cu,
+            suction: spec.ambient_pressure,
             motion: spec.clone(),
             steps: steps as f64,
         }

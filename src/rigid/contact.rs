@@ -9,6 +9,12 @@
 //! λ ← p until the multipliers settle, so the penetration vanishes however soft the penalty.
 //! The shear τ is a stick penalty on the tangential slip of the increment, returned to ±α·cu
 //! when it exceeds it.
+//!
+//! Which nodes touch is fixed during a Newton solve (the active set): a node whose pressure
+//! would pass through zero keeps its penalty spring until the solve converges, and only then is
+//! released (or a free node that penetrated is taken in), before the next solve. Letting nodes
+//! switch inside Newton makes a stiff penalty cycle: a full step pushes a node just out, the
+//! next pulls it back in.
 
 use super::shape::Shape;
 
@@ -33,6 +39,16 @@ pub struct ContactPair {
     pub shear_limit: f64,
     /// The body's displacement over the increment.
     pub body_increment: [f64; 2],
+    /// Penetration tolerated without reaction (m, <= 0): the node's signed distance to the body
+    /// at the start of the increment when it was already inside. A straight-sided P2 edge
+    /// between two nodes on a curved face has its midside node inside by the sagitta h²/8R;
+    /// pushing it out would fight the element's geometry, so the gap is measured from there.
+    pub offset: f64,
+    /// In the active set: its penalty spring acts during this Newton solve.
+    pub active: bool,
+    /// Suction (Pa, >= 0) the interface carries before it separates: the pressure may fall
+    /// to −suction (an ambient pressure the soil is modelled without).
+    pub suction: f64,
 }
 
 /// Force of the body on the node, its derivative and the interface state.
@@ -42,11 +58,12 @@ pub struct PairForce {
     pub force: [f64; 2],
     /// d force / d u, row-major.
     pub tangent: [[f64; 2]; 2],
-    /// Normal pressure (Pa), >= 0.
+    /// Normal pressure (Pa); for an inactive node the pressure it would have if it touched
+    /// (the next active set takes it in when that exceeds −suction).
     pub pressure: f64,
     /// Shear stress along t (Pa).
     pub shear: f64,
-    /// Signed distance to the body (m), negative inside.
+    /// Signed distance to the body (m), negative inside, less the tolerated offset.
     pub gap: f64,
 }
 
@@ -59,21 +76,24 @@ pub fn pair_force(pair: &ContactPair, shape: &Shape, u: [f64; 2]) -> PairForce {
     let t = [-n[1], n[0]];
     let kappa = prox.curvature;
     let eps = pair.penalty;
-    let p = pair.multiplier - eps * prox.distance;
+    let p = pair.multiplier - eps * (prox.distance - pair.offset);
     let none = PairForce {
         force: [0.0; 2],
         tangent: [[0.0; 2]; 2],
         pressure: 0.0,
         shear: 0.0,
-        gap: prox.distance,
+        gap: prox.distance - pair.offset,
     };
-    if p <= 0.0 {
-        return none;
+    if !pair.active {
+        return PairForce {
+            pressure: p,
+            ..none
+        };
     }
     // Slip of the node relative to the body over the increment, along the current tangent.
     let d = [u[0] - pair.body_increment[0], u[1] - pair.body_increment[1]];
     let (mut tau, mut dtau) = (0.0, 0.0);
-    if pair.shear_limit > 0.0 {
+    if pair.shear_limit > 0.0 && p + pair.suction > 0.0 {
         let slip = d[0] * t[0] + d[1] * t[1];
         let trial = pair.shear_start + eps * slip;
         if trial.abs() <= pair.shear_limit {
@@ -97,7 +117,7 @@ pub fn pair_force(pair: &ContactPair, shape: &Shape, u: [f64; 2]) -> PairForce {
         tangent,
         pressure: p,
         shear: tau,
-        gap: prox.distance,
+        gap: prox.distance - pair.offset,
     }
 }
 
@@ -116,6 +136,9 @@ mod tests {
             shear_start,
             shear_limit,
             body_increment: [0.001, -0.002],
+            offset: 0.0,
+            active: true,
+            suction: 0.0,
         }
     }
 
@@ -173,6 +196,7 @@ mod tests {
         let mut away = pair(0.0, 0.0);
         away.start = [2.0, 2.0];
         away.multiplier = 0.0;
+        away.active = false;
         assert_eq!(pair_force(&away, &circle, [0.0; 2]).force, [0.0; 2]);
     }
 }

@@ -88,13 +88,14 @@ impl Simulation {
         nodes.sort_unstable_by_key(|(n, _)| *n);
         for (bi, body) in model.bodies.iter().enumerate() {
             let shape = &out.bodies[bi];
+            let shape_from = body.shape(from);
             let d0 = body.displacement(from);
             let d1 = body.displacement(to);
             let inc = [d1[0] - d0[0], d1[1] - d0[1]];
             let moved = inc[0].hypot(inc[1]);
             let bb = shape.bounding_box();
             for &(n, w) in &nodes {
-                let (x, h, key) = node_info(mesh, dofs, n as usize, n_vertex);
+                let (x, h, key, points) = node_info(mesh, dofs, n as usize, n_vertex);
                 let margin = 2.0 * h + moved;
                 let outside_box = x[0] < bb[0][0] - margin
                     || x[0] > bb[1][0] + margin
@@ -103,23 +104,39 @@ impl Simulation {
                 if outside_box || shape.closest(x).distance > margin {
                     continue;
                 }
+                let touching = state.contains_key(&(key, bi as u32));
                 let carried = state.get(&(key, bi as u32)).copied().unwrap_or_else(|| {
-                    // A new edge node starts from the mean of its ends.
+                    // A new edge node starts from the mean of its ends; a node new to the
+                    // contact from the normal stress the soil carries there, so that a body
+                    // wished in place in stressed ground starts in equilibrium.
                     let [a, b] = key;
                     let ends = [
                         state.get(&([a, a], bi as u32)),
                         state.get(&([b, b], bi as u32)),
                     ];
                     let v: Vec<[f64; 2]> = ends.into_iter().flatten().copied().collect();
-                    if a == b || v.is_empty() {
-                        [0.0; 2]
-                    } else {
+                    if a != b && !v.is_empty() {
                         let k = v.len() as f64;
-                        [
+                        return [
                             v.iter().map(|s| s[0]).sum::<f64>() / k,
                             v.iter().map(|s| s[1]).sum::<f64>() / k,
-                        ]
+                        ];
                     }
+                    let prox = shape.closest(x);
+                    if prox.distance > 0.25 * h {
+                        return [0.0; 2];
+                    }
+                    let sigma = |p: usize| {
+                        let s =
+                            self.point_value(mesh, p, &self.particles.state, &self.ghosts.state);
+                        [s[0], s[1], s[3]]
+                    };
+                    let (sa, sb) = (sigma(points[0]), sigma(points[1]));
+                    let s: [f64; 3] = std::array::from_fn(|k| 0.5 * (sa[k] + sb[k]));
+                    let nn = prox.normal;
+                    let normal =
+                        s[0] * nn[0] * nn[0] + 2.0 * s[2] * nn[0] * nn[1] + s[1] * nn[1] * nn[1];
+                    [(-normal).max(0.0), 0.0]
                 });
                 out.pairs.push(ContactPair {
                     node: n,
@@ -131,7 +148,21 @@ impl Simulation {
                     shear_start: carried[1],
                     shear_limit: body.shear_limit,
                     body_increment: inc,
+                    offset: shape_from.closest(x).distance.min(0.0),
+                    active: false,
+                    suction: body.suction,
                 });
+                // Active when it touched at the end of the last increment, or when the body,
+                // where it will be, presses on the node where it is.
+                let last = out.pairs.len() - 1;
+                let p = &mut out.pairs[last];
+                // A body that holds suction keeps what lies on it at the start of the
+                // increment, as the soil on a bar's back follows it.
+                let on_body = p.suction > 0.0 && shape_from.closest(x).distance <= 0.01 * h;
+                p.active = touching
+                    || on_body
+                    || p.multiplier - p.penalty * (shape.closest(x).distance - p.offset)
+                        > -p.suction;
                 out.spacing.push(h);
             }
         }
@@ -177,16 +208,17 @@ impl Simulation {
     }
 }
 
-/// Start position, spacing and global key of local node `n`.
+/// Start position, spacing, global key and end points (twice the point for a vertex) of local
+/// node `n`.
 fn node_info(
     mesh: &LocalMesh,
     dofs: &DofMap,
     n: usize,
     n_vertex: usize,
-) -> ([f64; 2], f64, [u64; 2]) {
+) -> ([f64; 2], f64, [u64; 2], [usize; 2]) {
     if n < n_vertex {
         let p = dofs.node_point[n] as usize;
-        (mesh.points[p], mesh.h[p], [mesh.gids[p]; 2])
+        (mesh.points[p], mesh.h[p], [mesh.gids[p]; 2], [p, p])
     } else {
         let [a, b] = dofs.edges[n - n_vertex].map(|p| p as usize);
         let (xa, xb) = (mesh.points[a], mesh.points[b]);
@@ -194,6 +226,7 @@ fn node_info(
             [0.5 * (xa[0] + xb[0]), 0.5 * (xa[1] + xb[1])],
             mesh.h[a].max(mesh.h[b]),
             edge_key(mesh.gids[a], mesh.gids[b]),
+            [a, b],
         )
     }
 }

@@ -112,7 +112,13 @@ fn pressure(state: &[f64; GaussState::LEN]) -> f64 {
 }
 
 impl Simulation {
-    fn point_value<T: Copy>(&self, mesh: &LocalMesh, p: usize, owned: &[T], ghost: &[T]) -> T {
+    pub(super) fn point_value<T: Copy>(
+        &self,
+        mesh: &LocalMesh,
+        p: usize,
+        owned: &[T],
+        ghost: &[T],
+    ) -> T {
         if p < mesh.n_owned {
             owned[p]
         } else {
@@ -312,10 +318,17 @@ impl Simulation {
                 let a = problem.augment(&local, spacing);
                 let change = max_f64(world, a.change);
                 let pressure = max_f64(world, a.pressure);
-                if change <= contact.tolerance * pressure
-                    || augmentations + 1 >= contact.max_augmentations as usize
-                {
+                let switched = sum_f64(world, &[a.switched as f64])[0];
+                if switched == 0.0 && change <= contact.tolerance * pressure {
                     break;
+                }
+                if augmentations + 1 >= contact.max_augmentations as usize {
+                    return Err(SolveError::Diverged(format!(
+                        "step {step}: contact did not settle in {} Newton solves ({switched} \
+                         nodes still changing contact, pressures by {:.1e} relative)",
+                        contact.max_augmentations,
+                        change / pressure.max(f64::MIN_POSITIVE)
+                    )));
                 }
                 augmentations += 1;
                 let more = newton(&mut problem, x, jac)?;
@@ -358,7 +371,7 @@ impl Simulation {
             let b = &mut body_force[c.body as usize];
             b[0] -= f.force[0];
             b[1] -= f.force[1];
-            if f.pressure > 0.0 {
+            if c.active {
                 let key = node_key(mesh, dofs, c.node as usize);
                 contact_state.insert((key, c.body), [f.pressure, f.shear]);
             }

@@ -131,10 +131,24 @@ fn carve_rigid(scene: &Scene, base: ParticleSet) -> ParticleSet {
             .filter(|(p, _)| shape.closest(**p).distance < near)
             .map(|(_, h)| *h)
             .fold(scene.mesh.h, f64::min);
-        for p in shape.surface_points(spacing) {
-            if strictly_inside(p, 0.25 * spacing) {
-                ring.push((p, spacing));
-            }
+        // An even count on a circle puts points at its top and bottom, where a symmetry plane
+        // through the centre cuts it.
+        let sample = if shape.core().len() == 1 {
+            let half = (std::f64::consts::PI * shape.radius() / spacing).ceil();
+            std::f64::consts::PI * shape.radius() / half * (1.0 + 1e-12)
+        } else {
+            spacing
+        };
+        let points = shape.surface_points(sample);
+        // A body wished in place is lined where it lies in the soil, up to and including the
+        // body's outline (a symmetry plane); one resting on the surface is left alone.
+        if points.iter().any(|p| strictly_inside(*p, 0.25 * spacing)) {
+            ring.extend(
+                points
+                    .into_iter()
+                    .filter(|p| strictly_inside(*p, -tol))
+                    .map(|p| (p, spacing)),
+            );
         }
     }
     let mut points: Vec<([f64; 2], f64)> = Vec::with_capacity(base.len() + ring.len());

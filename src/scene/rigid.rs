@@ -40,6 +40,16 @@ pub struct Rigid {
     /// α·cu (stick below, slip at the limit). 0 = smooth (default), 1 = fully rough.
     #[serde(default)]
     pub adhesion: f64,
+    /// Uniform pressure the soil around the body is under (Pa, default 0): a surcharge on
+    /// weightless clay, which changes no stress difference. The soil is modelled without it
+    /// (its stresses are the excess over it) and the interface carries suction up to it before
+    /// it separates, as it would under the surcharge.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub ambient_pressure: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -267,6 +277,7 @@ mod tests {
                 },
             ],
             adhesion: 0.0,
+            ambient_pressure: 0.0,
         };
         assert_eq!(r.stage_steps(), 250);
         assert_eq!(r.displacement_at(25.0), [0.0, -0.01]);

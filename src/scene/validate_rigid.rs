@@ -72,6 +72,12 @@ pub fn check(s: &Scene) -> Result<(), Invalid> {
                 format!("must be in [0, 1] (got {})", r.adhesion),
             );
         }
+        if !(r.ambient_pressure >= 0.0 && r.ambient_pressure.is_finite()) {
+            return fail(
+                path.join("ambient_pressure"),
+                format!("must be >= 0 (got {})", r.ambient_pressure),
+            );
+        }
         if r.adhesion > 0.0 && s.material.model != MaterialModel::Tresca {
             return fail(
                 path.join("adhesion"),

@@ -53,6 +53,8 @@ pub struct Augmentation {
     pub pressure: f64,
     /// Largest penetration as a fraction of the node's spacing.
     pub penetration: f64,
+    /// Nodes that entered or left the active set.
+    pub switched: usize,
 }
 
 /// One element's contribution: residual, row-major tangent, states; dof order as the element's.
@@ -274,16 +276,23 @@ impl<'a> StepProblem<'a> {
         &self.setup.contact
     }
 
-    /// Updates the augmented multipliers from the solution `local`: λ ← max(0, λ − ε g).
-    /// `spacing` is each pair's node spacing, to report the penetration relative to it.
+    /// Updates the active set and the augmented multipliers from the solution `local`:
+    /// λ ← max(−suction, λ − ε g), active where that exceeds −suction. `spacing` is each pair's node
+    /// spacing, to report the penetration relative to it.
     pub fn augment(&mut self, local: &[f64], spacing: &[f64]) -> Augmentation {
         let forces = self.contact_forces(local);
         let mut a = Augmentation::default();
         for ((c, f), h) in self.setup.contact.iter_mut().zip(&forces).zip(spacing) {
-            a.change = a.change.max((f.pressure - c.multiplier).abs());
-            a.pressure = a.pressure.max(f.pressure);
+            let p = f.pressure.max(-c.suction);
+            a.change = a.change.max((p - c.multiplier).abs());
+            a.pressure = a.pressure.max(p + c.suction);
             a.penetration = a.penetration.max(-f.gap / h);
-            c.multiplier = f.pressure;
+            let active = f.pressure > -c.suction;
+            if active != c.active {
+                a.switched += 1;
+            }
+            c.active = active;
+            c.multiplier = p;
         }
         a
     }
@@ -362,7 +371,7 @@ impl StepProblem<'_> {
         for (c, f) in self.setup.contact.iter().zip(self.contact_forces(local)) {
             let n = c.node as usize;
             for i in 0..2 {
-                if self.free(n, i) && f.pressure > 0.0 {
+                if self.free(n, i) {
                     for k in 0..2 {
                         add(g(n, i), g(n, k), -f.tangent[i][k])?;
                     }

@@ -1,34 +1,23 @@
-//! Load–displacement pictures of `history.csv`, one per scene kind, with the reference
-//! solutions drawn alongside the run's results.
-
-use std::path::Path;
+//! One chart of a picture: the run's curves and reference curves on axes fitted to them, with a
+//! legend in the emptiest corner. The history pictures (`legacy`, `declared`) are made of these.
 
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::font::FAMILY;
-use super::history::{History, Kind};
-use super::picture::{save, Area, Drawn};
-use super::reference::{DEEP_STRIP, ELASTICA, ISOCHORIC, PRANDTL, REISSNER, TRESCA_COMPRESSION};
-use super::PlotError;
-
-/// Width and height in pixels of the load–displacement picture of a cantilever or a footing.
-pub const CURVE_SIZE: (u32, u32) = (1000, 700);
-/// Width and height in pixels of a block's picture: stress above, volume ratio below.
-pub const BLOCK_SIZE: (u32, u32) = (1000, 1200);
 
 /// A run's results get markers while they are this sparse; denser runs are a plain line.
 const MAX_MARKED: usize = 60;
 
-const RESULT_U: RGBColor = RGBColor(31, 90, 200);
-const RESULT_V: RGBColor = RGBColor(200, 40, 40);
-const REFERENCE_LOW: RGBColor = RGBColor(0, 140, 60);
-const REFERENCE_HIGH: RGBColor = RGBColor(150, 60, 170);
+pub(super) const RESULT_U: RGBColor = RGBColor(31, 90, 200);
+pub(super) const RESULT_V: RGBColor = RGBColor(200, 40, 40);
+pub(super) const REFERENCE_LOW: RGBColor = RGBColor(0, 140, 60);
+pub(super) const REFERENCE_HIGH: RGBColor = RGBColor(150, 60, 170);
 
 /// How a curve is drawn.
 #[derive(Debug, Clone, Copy)]
-enum Look {
+pub(super) enum Look {
     /// The run's results: a solid line.
     Result,
     /// A reference curve: a dashed line.
@@ -39,16 +28,16 @@ enum Look {
     Level(f64),
 }
 
-struct Curve {
+pub(super) struct Curve {
     /// Legend text; `None` for a curve that shares the legend entry of another.
-    label: Option<String>,
-    points: Vec<(f64, f64)>,
-    colour: RGBColor,
-    look: Look,
+    pub label: Option<String>,
+    pub points: Vec<(f64, f64)>,
+    pub colour: RGBColor,
+    pub look: Look,
 }
 
 impl Curve {
-    fn new(label: &str, points: Vec<(f64, f64)>, colour: RGBColor, look: Look) -> Self {
+    pub fn new(label: &str, points: Vec<(f64, f64)>, colour: RGBColor, look: Look) -> Self {
         Curve {
             label: Some(label.to_string()),
             points,
@@ -59,18 +48,18 @@ impl Curve {
 }
 
 /// One chart of a picture.
-struct Panel {
-    caption: String,
-    x_desc: &'static str,
-    y_desc: &'static str,
-    curves: Vec<Curve>,
+pub(super) struct Panel {
+    pub caption: String,
+    pub x_desc: String,
+    pub y_desc: String,
+    pub curves: Vec<Curve>,
     /// Whether the y axis starts at zero (loads) or fits the values (a ratio near 1).
-    y_from_zero: bool,
+    pub y_from_zero: bool,
 }
 
 /// Range of `values`, widened to hold 0 when `with_zero`, padded by 4 % on a side not at zero,
 /// never empty.
-fn span(values: impl Iterator<Item = f64>, with_zero: bool) -> (f64, f64) {
+pub(super) fn span(values: impl Iterator<Item = f64>, with_zero: bool) -> (f64, f64) {
     let (mut lo, mut hi) = values
         .filter(|v| v.is_finite())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
@@ -151,7 +140,7 @@ fn legend_corner(panel: &Panel, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosi
         .map_or(SeriesLabelPosition::LowerRight, |c| c.0)
 }
 
-fn draw_panel<DB: DrawingBackend>(
+pub(super) fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
@@ -174,8 +163,8 @@ fn draw_panel<DB: DrawingBackend>(
         .build_cartesian_2d(x0..x1, y0..y1)?;
     chart
         .configure_mesh()
-        .x_desc(panel.x_desc)
-        .y_desc(panel.y_desc)
+        .x_desc(panel.x_desc.as_str())
+        .y_desc(panel.y_desc.as_str())
         .axis_desc_style((FAMILY, 20))
         .label_style((FAMILY, 16))
         .light_line_style(RGBColor(235, 235, 235))
@@ -238,149 +227,6 @@ fn draw_panel<DB: DrawingBackend>(
             .draw()?;
     }
     Ok(())
-}
-
-fn cantilever(history: &History) -> Panel {
-    let reference = |k: usize| ELASTICA.iter().map(|r| (r[0], r[k])).collect::<Vec<_>>();
-    let reissner = |k: usize| REISSNER.iter().map(|r| (r[0], r[k])).collect::<Vec<_>>();
-    let mut reissner_v = Curve::new("", reissner(2), BLACK, Look::Points);
-    reissner_v.label = None;
-    Panel {
-        caption: "Cantilever: tip displacement against load".to_string(),
-        x_desc: "λ = P L² / (E I)",
-        y_desc: "u/L (shortening), v/L (deflection)",
-        curves: vec![
-            Curve::new(
-                "u/L, this run",
-                history.curve("lambda", "u_over_L"),
-                RESULT_U,
-                Look::Result,
-            ),
-            Curve::new(
-                "v/L, this run",
-                history.curve("lambda", "v_over_L"),
-                RESULT_V,
-                Look::Result,
-            ),
-            Curve::new(
-                "u/L, elastica (Bisshopp–Drucker)",
-                reference(1),
-                RESULT_U,
-                Look::Reference,
-            ),
-            Curve::new(
-                "v/L, elastica (Bisshopp–Drucker)",
-                reference(2),
-                RESULT_V,
-                Look::Reference,
-            ),
-            Curve::new(
-                "plane-strain Reissner beam",
-                reissner(1),
-                BLACK,
-                Look::Points,
-            ),
-            reissner_v,
-        ],
-        y_from_zero: true,
-    }
-}
-
-fn footing(history: &History) -> Panel {
-    Panel {
-        caption: "Strip footing: bearing pressure against penetration".to_string(),
-        x_desc: "z/B",
-        y_desc: "q/cu",
-        curves: vec![
-            Curve::new(
-                "q/cu, this run",
-                history.curve("z_over_B", "q_over_cu"),
-                RESULT_U,
-                Look::Result,
-            ),
-            Curve::new(
-                "Prandtl, 2 + π = 5.142",
-                Vec::new(),
-                REFERENCE_LOW,
-                Look::Level(PRANDTL),
-            ),
-            Curve::new(
-                "deep smooth strip, 2 + 2π = 8.28",
-                Vec::new(),
-                REFERENCE_HIGH,
-                Look::Level(DEEP_STRIP),
-            ),
-        ],
-        y_from_zero: true,
-    }
-}
-
-fn block_stress(history: &History) -> Panel {
-    Panel {
-        caption: "Block: stress against strain".to_string(),
-        x_desc: "strain",
-        y_desc: "stress/cu",
-        curves: vec![
-            Curve::new(
-                "stress/cu, this run",
-                history.curve("strain", "stress_over_cu"),
-                RESULT_U,
-                Look::Result,
-            ),
-            Curve::new(
-                "Tresca strength, 2 cu",
-                Vec::new(),
-                REFERENCE_LOW,
-                Look::Level(TRESCA_COMPRESSION),
-            ),
-        ],
-        y_from_zero: true,
-    }
-}
-
-fn block_volume(history: &History) -> Panel {
-    Panel {
-        caption: "Block: volume against strain".to_string(),
-        x_desc: "strain",
-        y_desc: "V / V₀",
-        curves: vec![
-            Curve::new(
-                "volume ratio, this run",
-                history.curve("strain", "volume_ratio"),
-                RESULT_U,
-                Look::Result,
-            ),
-            Curve::new(
-                "isochoric, 1",
-                Vec::new(),
-                REFERENCE_LOW,
-                Look::Level(ISOCHORIC),
-            ),
-        ],
-        y_from_zero: false,
-    }
-}
-
-/// Writes the load–displacement picture of `history` to `path`.
-pub(crate) fn draw(history: &History, path: &Path) -> Result<(), PlotError> {
-    match history.kind {
-        Kind::Cantilever => {
-            let panel = cantilever(history);
-            save(path, CURVE_SIZE, |root: &Area<'_>| draw_panel(root, &panel))
-        }
-        Kind::Footing => {
-            let panel = footing(history);
-            save(path, CURVE_SIZE, |root: &Area<'_>| draw_panel(root, &panel))
-        }
-        Kind::Block => {
-            let panels = [block_stress(history), block_volume(history)];
-            save(path, BLOCK_SIZE, |root: &Area<'_>| -> Drawn<'_> {
-                let (top, bottom) = root.split_vertically(BLOCK_SIZE.1 / 2);
-                draw_panel(&top, &panels[0])?;
-                draw_panel(&bottom, &panels[1])
-            })
-        }
-    }
 }
 
 #[cfg(test)]
