@@ -323,6 +323,12 @@ impl Shape {
         (p, -self.closest(p).distance)
     }
 
+    /// Radius of the largest disk inside the shape: half the body's thickness where it is
+    /// thinnest across its middle (a plate's half width, a circle's radius).
+    pub fn inradius(&self) -> f64 {
+        self.deepest().1
+    }
+
     /// Depth by which the closed triangle `tri` reaches into the shape: max over the triangle of
     /// -signed distance, clamped to >= 0. -signed distance is concave, so its maximum over the
     /// triangle is on an edge (computed exactly by `segment_depth`) or is the global maximum at

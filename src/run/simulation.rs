@@ -13,9 +13,6 @@ use mpi::traits::Communicator;
 use pfem_partition::{imbalance, max_f64, migrate, partition_graph, sum_f64, Comm};
 use std::path::Path;
 
-/// A triangle reaching deeper than this fraction of its spacing into a rigid body is removed.
-pub const CROSSING_DEPTH: f64 = 0.25;
-
 /// Repartition when the largest rank holds this much more than the mean.
 const IMBALANCE_LIMIT: f64 = 1.2;
 
@@ -36,6 +33,8 @@ pub struct Simulation {
     pub(super) last_contact: std::cell::RefCell<super::contact::ContactState>,
     /// Contact augmentations (Newton solves after the first) since the last step report.
     pub(super) augmentations: std::cell::Cell<u64>,
+    /// The current piece is being retried with the other line search.
+    pub(super) alternate_search: std::cell::Cell<bool>,
     /// Seconds spent on contact since the last step report.
     pub(super) contact_seconds: std::cell::Cell<f64>,
     /// PETSc objects of the last increment (kept while the matrix pattern stays the same).
@@ -107,6 +106,7 @@ impl Simulation {
             last_contact: Default::default(),
             augmentations: Default::default(),
             contact_seconds: Default::default(),
+            alternate_search: Default::default(),
             solver: Default::default(),
             last_nodes: Default::default(),
             remapped: Default::default(),
@@ -184,24 +184,15 @@ impl Simulation {
         Ok(mesh)
     }
 
-    /// Removes the triangles that reach into a rigid body deeper than a quarter of their
-    /// spacing: the alpha shape alone would bridge particles across a thin body, or close the
-    /// soil over a body's corner. A chord between two particles on a curved face dips into the
-    /// body by only h²/8R, far less. Rank-local and decided from the triangle's own data.
+    /// Removes the triangles that cross a rigid body (`crate::rigid::crosses`).
     fn drop_crossing(&self, mesh: &mut LocalMesh, rank: i32) {
         if self.model.bodies.is_empty() {
             return;
         }
         let lambda = self.header.load_factor;
         let shapes: Vec<_> = self.model.bodies.iter().map(|b| b.shape(lambda)).collect();
-        let boxes: Vec<_> = shapes.iter().map(|s| s.bounding_box()).collect();
         mesh.drop_triangles(rank, |p, h| {
-            shapes.iter().zip(&boxes).any(|(s, bb)| {
-                let lo = |c: usize| p.iter().map(|q| q[c]).fold(f64::INFINITY, f64::min);
-                let hi = |c: usize| p.iter().map(|q| q[c]).fold(f64::NEG_INFINITY, f64::max);
-                let apart = (0..2).any(|c| lo(c) > bb[1][c] || hi(c) < bb[0][c]);
-                !apart && s.triangle_depth(p) > CROSSING_DEPTH * h
-            })
+            shapes.iter().any(|s| crate::rigid::crosses(s, p, h))
         });
     }
 

@@ -212,7 +212,9 @@ impl Simulation {
         world: &Comm,
         dofs: &DofMap,
     ) -> Result<SolverObjects, crate::petsc::PetscError> {
-        let signature = pattern_signature(dofs);
+        // A different line search is a different SNES.
+        let alternate = self.alternate_search.get();
+        let signature = pattern_signature(dofs) ^ if alternate { 0x9e37_79b9_7f4a_7c15 } else { 0 };
         let cached = self.solver.borrow_mut().take();
         let same = cached.as_ref().is_some_and(|c| c.signature == signature);
         if sum_f64(world, &[if same { 0.0 } else { 1.0 }])[0] == 0.0 {
@@ -231,6 +233,14 @@ impl Simulation {
             LineSearch::Bt => "bt",
             LineSearch::L2 => "l2",
             LineSearch::Cp => "cp",
+        };
+        // The retry after a divergence: full steps if the line search backtracked, else
+        // backtracking. Backtracking can stall at a kink of the plastic or contact response that
+        // a full step jumps over, and a full step can overshoot where backtracking does not.
+        let line_search = match (alternate, line_search) {
+            (false, ls) => ls,
+            (true, "bt") => "basic",
+            (true, _) => "bt",
         };
         let snes = Snes::new(
             world,
@@ -514,7 +524,8 @@ const MAX_CUTS: usize = 6;
 
 impl Simulation {
     /// Collective. Solves the next step on `mesh` and moves the particles. When Newton diverges,
-    /// the rest of the step is cut in half (up to 6 times, growing back after each success), each
+    /// the piece is tried once more with the other line search (full steps or backtracking),
+    /// then the rest of the step is cut in half (up to 6 times, growing back after each success), each
     /// piece a full remesh–map–solve–update cycle; `mesh` ends as the mesh of the last piece.
     pub fn advance(
         &mut self,
@@ -537,6 +548,7 @@ impl Simulation {
             };
             match self.solve(world, petsc, mesh, &states, from, to) {
                 Ok(solved) => {
+                    self.alternate_search.set(false);
                     let completes = to == target;
                     let mut report = self.update(world, mesh, solved, completes)?;
                     report.penetration = self.check_penetration(world)?;
@@ -555,7 +567,11 @@ impl Simulation {
                     *mesh = self.remesh(world)?;
                     states = self.map(mesh);
                 }
+                Err(SolveError::Diverged(_)) if !self.alternate_search.get() => {
+                    self.alternate_search.set(true);
+                }
                 Err(SolveError::Diverged(_)) if cuts < MAX_CUTS => {
+                    self.alternate_search.set(false);
                     cuts += 1;
                     piece *= 0.5;
                 }
