@@ -7,14 +7,15 @@
 //! The normal pressure is p = max(0, λ − ε_N g) with g the signed distance of the node to the
 //! body at the end of the increment and λ the augmented multiplier; after Newton converges,
 //! λ ← p until the multipliers settle, so the penetration vanishes however soft the penalty.
-//! The shear τ is a stick penalty on the tangential slip of the increment, returned to ±α·cu
-//! when it exceeds it.
+//! The shear τ is a stick penalty on the tangential slip of the increment; a node whose stick
+//! shear exceeds α·cu slips with ±α·cu.
 //!
 //! Which nodes touch is fixed during a Newton solve (the active set): a node whose pressure
 //! would pass through zero keeps its penalty spring until the solve converges, and only then is
 //! released (or a free node that penetrated is taken in), before the next solve. Letting nodes
 //! switch inside Newton makes a stiff penalty cycle: a full step pushes a node just out, the
-//! next pulls it back in.
+//! next pulls it back in. Should the set itself keep changing between solves, it is kept after
+//! half the allowed solves and only the multipliers converge.
 
 use super::shape::Shape;
 
@@ -49,6 +50,9 @@ pub struct ContactPair {
     /// Suction (Pa, >= 0) the interface carries before it separates: the pressure may fall
     /// to −suction (an ambient pressure the soil is modelled without).
     pub suction: f64,
+    /// Interface state during this Newton solve: 0 sticks (shear from the penalty), ±1 slips
+    /// with shear ±α·cu. Decided between solves, like the active set.
+    pub slip: i8,
 }
 
 /// Force of the body on the node, its derivative and the interface state.
@@ -63,6 +67,10 @@ pub struct PairForce {
     pub pressure: f64,
     /// Shear stress along t (Pa).
     pub shear: f64,
+    /// The stick shear the penalty would give (Pa), and the node's slip along t relative to the
+    /// body over the increment (m): the next solve's stick/slip decision.
+    pub shear_trial: f64,
+    pub slip: f64,
     /// Signed distance to the body (m), negative inside, less the tolerated offset.
     pub gap: f64,
 }
@@ -82,6 +90,8 @@ pub fn pair_force(pair: &ContactPair, shape: &Shape, u: [f64; 2]) -> PairForce {
         tangent: [[0.0; 2]; 2],
         pressure: 0.0,
         shear: 0.0,
+        shear_trial: 0.0,
+        slip: 0.0,
         gap: prox.distance - pair.offset,
     };
     if !pair.active {
@@ -92,15 +102,15 @@ pub fn pair_force(pair: &ContactPair, shape: &Shape, u: [f64; 2]) -> PairForce {
     }
     // Slip of the node relative to the body over the increment, along the current tangent.
     let d = [u[0] - pair.body_increment[0], u[1] - pair.body_increment[1]];
-    let (mut tau, mut dtau) = (0.0, 0.0);
-    if pair.shear_limit > 0.0 && p + pair.suction > 0.0 {
-        let slip = d[0] * t[0] + d[1] * t[1];
-        let trial = pair.shear_start + eps * slip;
-        if trial.abs() <= pair.shear_limit {
+    let (mut tau, mut dtau, mut trial) = (0.0, 0.0, 0.0);
+    let slip = d[0] * t[0] + d[1] * t[1];
+    if pair.shear_limit > 0.0 {
+        trial = pair.shear_start + eps * slip;
+        if pair.slip == 0 {
             tau = trial;
             dtau = eps * (1.0 - kappa * (d[0] * n[0] + d[1] * n[1]));
         } else {
-            tau = pair.shear_limit * trial.signum();
+            tau = pair.shear_limit * f64::from(pair.slip);
         }
     }
     let w = pair.weight;
@@ -117,6 +127,8 @@ pub fn pair_force(pair: &ContactPair, shape: &Shape, u: [f64; 2]) -> PairForce {
         tangent,
         pressure: p,
         shear: tau,
+        shear_trial: trial,
+        slip,
         gap: prox.distance - pair.offset,
     }
 }
@@ -139,6 +151,7 @@ mod tests {
             offset: 0.0,
             active: true,
             suction: 0.0,
+            slip: 0,
         }
     }
 
@@ -174,7 +187,9 @@ mod tests {
         // Frictionless, stick and slip, on a curved surface.
         check_tangent(&pair(0.0, 0.0), &circle, u);
         check_tangent(&pair(1e9, 100.0), &circle, u);
-        check_tangent(&pair(500.0, 450.0), &circle, u);
+        let mut slipping = pair(500.0, 450.0);
+        slipping.slip = 1;
+        check_tangent(&slipping, &circle, u);
         let square =
             Shape::polygon(&[[-1.0, -2.0], [1.0, -2.0], [1.0, -1.0], [-1.0, -1.0]], 0.0).unwrap();
         let mut p = pair(1e9, -30.0);
@@ -191,8 +206,12 @@ mod tests {
         let cross = f.force[0] * x[1] - f.force[1] * x[0];
         assert!(cross.abs() < 1e-12 * f.force[0].abs().max(f.force[1].abs()));
         assert_eq!(f.shear, 0.0);
-        let f = pair_force(&pair(500.0, 450.0), &circle, [0.05, 0.0]);
-        assert_eq!(f.shear.abs(), 500.0);
+        let mut slipping = pair(500.0, 450.0);
+        slipping.slip = -1;
+        let f = pair_force(&slipping, &circle, [0.05, 0.0]);
+        assert_eq!(f.shear, -500.0);
+        let stuck = pair_force(&pair(500.0, 450.0), &circle, [0.05, 0.0]);
+        assert!(stuck.shear_trial.abs() > 500.0, "the next solve slips");
         // Far from the body: no force.
         let mut away = pair(0.0, 0.0);
         away.start = [2.0, 2.0];

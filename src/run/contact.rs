@@ -50,7 +50,8 @@ impl Simulation {
             .enumerate()
             .map(|(i, e)| ((e[0], e[1]), (n_vertex + i) as u32))
             .collect();
-        let mut weight: HashMap<u32, f64> = HashMap::new();
+        // Boundary edges with their nodes [a, m, b] and start length.
+        let mut edges: Vec<([u32; 3], [f64; 2], f64, f64)> = Vec::new();
         for e in &mesh.boundary_edges {
             let [a, b] = *e;
             let (ga, gb) = (mesh.gids[a as usize], mesh.gids[b as usize]);
@@ -62,10 +63,13 @@ impl Simulation {
             let nb = dofs.node_of_point[b as usize];
             let (xa, xb) = (mesh.points[a as usize], mesh.points[b as usize]);
             let len = ((xb[0] - xa[0]).powi(2) + (xb[1] - xa[1]).powi(2)).sqrt();
-            let w = simpson_weights(len);
-            for (node, wk) in [na, m, nb].into_iter().zip(w) {
-                *weight.entry(node).or_default() += wk;
-            }
+            let mid = [0.5 * (xa[0] + xb[0]), 0.5 * (xa[1] + xb[1])];
+            edges.push((
+                [na, m, nb],
+                mid,
+                len,
+                mesh.h[a as usize].max(mesh.h[b as usize]),
+            ));
             for sp in &model.scene.surface_pressure {
                 let inside = |p: u32| {
                     sp.region
@@ -81,11 +85,6 @@ impl Simulation {
         }
         let young = model.scene.material.young;
         let state = self.last_contact.borrow();
-        let mut nodes: Vec<(u32, f64)> = weight
-            .into_iter()
-            .filter(|(n, _)| dofs.node_owned[*n as usize])
-            .collect();
-        nodes.sort_unstable_by_key(|(n, _)| *n);
         for (bi, body) in model.bodies.iter().enumerate() {
             let shape = &out.bodies[bi];
             let shape_from = body.shape(from);
@@ -94,16 +93,30 @@ impl Simulation {
             let inc = [d1[0] - d0[0], d1[1] - d0[1]];
             let moved = inc[0].hypot(inc[1]);
             let bb = shape.bounding_box();
-            for &(n, w) in &nodes {
-                let (x, h, key, points) = node_info(mesh, dofs, n as usize, n_vertex);
-                let margin = 2.0 * h + moved;
-                let outside_box = x[0] < bb[0][0] - margin
-                    || x[0] > bb[1][0] + margin
-                    || x[1] < bb[0][1] - margin
-                    || x[1] > bb[1][1] + margin;
-                if outside_box || shape.closest(x).distance > margin {
+            // A node's weight counts only the boundary edges facing this body (midpoint within
+            // a quarter spacing of it, plus its motion): a corner node of a platen does not
+            // stand for the free side below it, whose length would add to its share of α·cu.
+            let mut weight: HashMap<u32, f64> = HashMap::new();
+            for (nodes, mid, len, h) in &edges {
+                let margin = 0.25 * h + moved;
+                let outside_box = mid[0] < bb[0][0] - margin
+                    || mid[0] > bb[1][0] + margin
+                    || mid[1] < bb[0][1] - margin
+                    || mid[1] > bb[1][1] + margin;
+                if outside_box || shape.closest(*mid).distance > margin {
                     continue;
                 }
+                for (node, wk) in nodes.iter().zip(simpson_weights(*len)) {
+                    *weight.entry(*node).or_default() += wk;
+                }
+            }
+            let mut nodes: Vec<(u32, f64)> = weight
+                .into_iter()
+                .filter(|(n, _)| dofs.node_owned[*n as usize])
+                .collect();
+            nodes.sort_unstable_by_key(|(n, _)| *n);
+            for &(n, w) in &nodes {
+                let (x, h, key, points) = node_info(mesh, dofs, n as usize, n_vertex);
                 let touching = state.contains_key(&(key, bi as u32));
                 let carried = state.get(&(key, bi as u32)).copied().unwrap_or_else(|| {
                     // A new edge node starts from the mean of its ends; a node new to the
@@ -151,6 +164,11 @@ impl Simulation {
                     offset: shape_from.closest(x).distance.min(0.0),
                     active: false,
                     suction: body.suction,
+                    slip: if body.shear_limit > 0.0 && carried[1].abs() >= body.shear_limit {
+                        carried[1].signum() as i8
+                    } else {
+                        0
+                    },
                 });
                 // Active when it touched at the end of the last increment, or when the body,
                 // where it will be, presses on the node where it is.

@@ -325,7 +325,10 @@ impl Simulation {
                 let local = problem
                     .local_values(x.as_ref())
                     .map_err(|e| err(e.to_string()))?;
-                let a = problem.augment(&local, spacing);
+                // Past half the allowed solves the active set is kept, so that nodes that keep
+                // entering and leaving it cannot stop the step.
+                let switch = 2 * (augmentations + 1) < contact.max_augmentations as usize;
+                let a = problem.augment(&local, spacing, switch);
                 let change = max_f64(world, a.change);
                 let pressure = max_f64(world, a.pressure);
                 let switched = sum_f64(world, &[a.switched as f64])[0];

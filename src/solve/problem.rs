@@ -279,7 +279,9 @@ impl<'a> StepProblem<'a> {
     /// Updates the active set and the augmented multipliers from the solution `local`:
     /// λ ← max(−suction, λ − ε g), active where that exceeds −suction. `spacing` is each pair's node
     /// spacing, to report the penetration relative to it.
-    pub fn augment(&mut self, local: &[f64], spacing: &[f64]) -> Augmentation {
+    /// With `switch` false the active set is kept (only the multipliers change): the last
+    /// resort when nodes keep entering and leaving it.
+    pub fn augment(&mut self, local: &[f64], spacing: &[f64], switch: bool) -> Augmentation {
         let forces = self.contact_forces(local);
         let mut a = Augmentation::default();
         for ((c, f), h) in self.setup.contact.iter_mut().zip(&forces).zip(spacing) {
@@ -288,10 +290,32 @@ impl<'a> StepProblem<'a> {
             a.pressure = a.pressure.max(p + c.suction);
             a.penetration = a.penetration.max(-f.gap / h);
             let active = f.pressure > -c.suction;
-            if active != c.active {
+            if switch && active != c.active {
                 a.switched += 1;
+                c.active = active;
             }
-            c.active = active;
+            if c.shear_limit > 0.0 {
+                // A sticking node slips once its stick shear passes α·cu; a slipping one sticks
+                // again when it slides back against its slip (a slipping solve overshoots the
+                // trial shear, so that is not the test).
+                let slip = if !c.active {
+                    0
+                } else if c.slip == 0 {
+                    if f.shear_trial.abs() <= c.shear_limit {
+                        0
+                    } else {
+                        f.shear_trial.signum() as i8
+                    }
+                } else if f.slip * f64::from(c.slip) > 0.0 {
+                    c.slip
+                } else {
+                    0
+                };
+                if switch && slip != c.slip {
+                    a.switched += 1;
+                    c.slip = slip;
+                }
+            }
             c.multiplier = p;
         }
         a
