@@ -21,6 +21,9 @@
 //!
 //! Pure numerics: no MPI, no PETSc.
 
+// Matrix code indexes rows and columns together.
+#![allow(clippy::needless_range_loop)]
+
 /// C_ij = ∫_{-1}^{1} N_i(s) N_j'(s) ds for the node order [a, m, b]. Rows sum to zero (a rigid
 /// translation does not change the load); C + Cᵀ = diag(-1, 0, 1) = [N_i N_j] from -1 to 1.
 const EDGE_C: [[f64; 3]; 3] = [
