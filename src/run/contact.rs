@@ -117,6 +117,14 @@ impl Simulation {
             nodes.sort_unstable_by_key(|(n, _)| *n);
             for &(n, w) in &nodes {
                 let (x, h, key, points) = node_info(mesh, dofs, n as usize, n_vertex);
+                // A midside node of an edge cut across a corner starts inside the body's core,
+                // where the normal jumps between faces: Newton stalls on it. Its edge's ends
+                // carry the contact there.
+                if shape_from.closest(x).distance < -shape_from.radius() - 1e-3 * h
+                    && shape_from.core().len() > 1
+                {
+                    continue;
+                }
                 let touching = state.contains_key(&(key, bi as u32));
                 let carried = state.get(&(key, bi as u32)).copied().unwrap_or_else(|| {
                     // A new edge node starts from the mean of its ends; a node new to the
