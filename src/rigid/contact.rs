@@ -40,11 +40,10 @@ pub struct ContactPair {
     pub shear_limit: f64,
     /// The body's displacement over the increment.
     pub body_increment: [f64; 2],
-    /// Penetration tolerated without reaction (m, <= 0): for a midside node, its signed
-    /// distance to the body at the start of the increment when it was already inside. A
-    /// straight-sided P2 edge between two nodes on a curved face has its midside node inside by
-    /// the sagitta h²/8R; pushing it out would fight the element's geometry, so the gap is
-    /// measured from there. Zero for a particle.
+    /// Penetration tolerated without reaction (m, <= 0): the node's signed distance to the body
+    /// at the start of the increment when it was already inside. A straight-sided P2 edge
+    /// between two nodes on a curved face has its midside node inside by the sagitta h²/8R;
+    /// pushing it out would fight the element's geometry, so the gap is measured from there.
     pub offset: f64,
     /// In the active set: its penalty spring acts during this Newton solve.
     pub active: bool,

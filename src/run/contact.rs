@@ -168,13 +168,7 @@ impl Simulation {
                     shear_start: carried[1],
                     shear_limit: body.shear_limit,
                     body_increment: inc,
-                    // Only a midside node keeps its start penetration (the chord's sagitta); a
-                    // particle is pushed back onto the face, so penetration cannot ratchet up.
-                    offset: if key[0] == key[1] {
-                        0.0
-                    } else {
-                        shape_from.closest(x).distance.min(0.0)
-                    },
+                    offset: shape_from.closest(x).distance.min(0.0),
                     active: false,
                     suction: body.suction,
                     slip: if body.shear_limit > 0.0 && carried[1].abs() >= body.shear_limit {
