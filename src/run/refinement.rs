@@ -13,6 +13,19 @@ use std::collections::HashSet;
 const K: usize = GaussState::LEN;
 
 impl Simulation {
+    /// Whether owned particle `p` has a support or prescribed displacement now.
+    fn constrained(&self, p: usize) -> bool {
+        self.model
+            .step_bc(
+                self.particles.reference_position(p),
+                self.particles.position[p],
+                self.header.load_factor,
+                self.header.load_factor,
+            )
+            .iter()
+            .any(Option::is_some)
+    }
+
     /// Collective. Inserts, removes and smooths particles as the scene asks; returns whether
     /// anything changed anywhere (then the mesh must be rebuilt).
     pub(super) fn refine(&mut self, world: &Comm, mesh: &LocalMesh) -> Result<bool, String> {
@@ -24,19 +37,20 @@ impl Simulation {
             smooth: settings.smooth,
             ..Default::default()
         };
+        // Particles pressed along a rigid body bunch up (the face is a boundary, the symmetry
+        // plane a support): there they may be merged like interior ones, or their edges shrink
+        // until Newton stalls. The closer neighbour that stays keeps the face and the support.
+        let lambda = self.header.load_factor;
+        let bodies: Vec<_> = self.model.bodies.iter().map(|b| b.shape(lambda)).collect();
+        let on_body = |p: usize| {
+            let x = self.particles.position[p];
+            bodies
+                .iter()
+                .any(|s| s.closest(x).distance < 0.25 * self.particles.h[p])
+        };
         let protected = |p: usize| {
             self.particles.flags[p] & flag::TRACKED != 0
-                || mesh.on_boundary[p]
-                || self
-                    .model
-                    .step_bc(
-                        self.particles.reference_position(p),
-                        self.particles.position[p],
-                        self.header.load_factor,
-                        self.header.load_factor,
-                    )
-                    .iter()
-                    .any(Option::is_some)
+                || !on_body(p) && (mesh.on_boundary[p] || self.constrained(p))
         };
         let mut plan = plan(mesh, protected, &params);
         if !settings.refine {
