@@ -13,19 +13,6 @@ use std::collections::HashSet;
 const K: usize = GaussState::LEN;
 
 impl Simulation {
-    /// Whether owned particle `p` has a support or prescribed displacement now.
-    fn constrained(&self, p: usize) -> bool {
-        self.model
-            .step_bc(
-                self.particles.reference_position(p),
-                self.particles.position[p],
-                self.header.load_factor,
-                self.header.load_factor,
-            )
-            .iter()
-            .any(Option::is_some)
-    }
-
     /// Collective. Inserts, removes and smooths particles as the scene asks; returns whether
     /// anything changed anywhere (then the mesh must be rebuilt).
     pub(super) fn refine(&mut self, world: &Comm, mesh: &LocalMesh) -> Result<bool, String> {
@@ -37,21 +24,19 @@ impl Simulation {
             smooth: settings.smooth,
             ..Default::default()
         };
-        // Particles pressed along a rigid body's face bunch up: there boundary particles may be
-        // merged like interior ones, or their edges shrink until Newton stalls. Supported ones
-        // (a symmetry plane) stay protected: merging them cost the T-bar a fifth of its Nc.
-        let lambda = self.header.load_factor;
-        let bodies: Vec<_> = self.model.bodies.iter().map(|b| b.shape(lambda)).collect();
-        let on_body = |p: usize| {
-            let x = self.particles.position[p];
-            bodies
-                .iter()
-                .any(|s| s.closest(x).distance < 0.25 * self.particles.h[p])
-        };
         let protected = |p: usize| {
             self.particles.flags[p] & flag::TRACKED != 0
-                || self.constrained(p)
-                || mesh.on_boundary[p] && !on_body(p)
+                || mesh.on_boundary[p]
+                || self
+                    .model
+                    .step_bc(
+                        self.particles.reference_position(p),
+                        self.particles.position[p],
+                        self.header.load_factor,
+                        self.header.load_factor,
+                    )
+                    .iter()
+                    .any(Option::is_some)
         };
         let mut plan = plan(mesh, protected, &params);
         if !settings.refine {
