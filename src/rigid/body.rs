@@ -38,9 +38,4 @@ impl RigidBody {
     pub fn shape(&self, lambda: f64) -> Shape {
         self.initial.translated(self.displacement(lambda))
     }
-
-    /// Stage running during step `step` (1-based; the stage count once all are done).
-    pub fn stage_of(&self, step: u64) -> usize {
-        self.motion.stage_of(step)
-    }
 }

@@ -27,7 +27,9 @@ pub fn crosses(shape: &Shape, tri: [[f64; 2]; 3], h: f64) -> bool {
     if (0..2).any(|c| lo(c) > bb[1][c] || hi(c) < bb[0][c]) {
         return false;
     }
-    shape.triangle_depth(tri) > CROSSING_DEPTH * h.min(shape.inradius())
+    // The inradius (a search over the core's edges) only when the spacing alone does not decide.
+    let depth = shape.triangle_depth(tri);
+    depth > CROSSING_DEPTH * h || depth > 0.0 && depth > CROSSING_DEPTH * shape.inradius()
 }
 
 #[cfg(test)]

@@ -356,14 +356,8 @@ impl Simulation {
         let elems = problem
             .elements(&local)
             .map_err(|e| SolveError::Fatal(format!("step {step}: {e}")))?;
-        let n_vertex = dofs.n_nodes() - dofs.edges.len();
         let driven = |n: usize| {
-            let pts: Vec<u32> = if n < n_vertex {
-                vec![dofs.node_point[n]]
-            } else {
-                dofs.edges[n - n_vertex].to_vec()
-            };
-            pts.iter().all(|&p| {
+            dofs.node_points(n).iter().all(|&p| {
                 let p = p as usize;
                 self.model.in_first_prescribed(
                     self.reference_position(mesh, p),
@@ -420,7 +414,6 @@ impl Simulation {
             .iter()
             .map(|f| f.name.is_some())
             .chain(scene.prescribed.iter().map(|p| p.name.is_some()));
-        let n_vertex = dofs.n_nodes() - dofs.edges.len();
         names
             .enumerate()
             .map(|(set, named)| {
@@ -428,12 +421,7 @@ impl Simulation {
                     return [0.0; 2];
                 }
                 problem.reaction(elems, |n| {
-                    let pts: Vec<u32> = if n < n_vertex {
-                        vec![dofs.node_point[n]]
-                    } else {
-                        dofs.edges[n - n_vertex].to_vec()
-                    };
-                    pts.iter().all(|&p| {
+                    dofs.node_points(n).iter().all(|&p| {
                         let p = p as usize;
                         self.model.in_set(
                             set,

@@ -241,19 +241,6 @@ impl Rigid {
         }
         from
     }
-
-    /// Index of the stage running during step `step` (1-based step), or the number of stages
-    /// once all are done.
-    pub fn stage_of(&self, step: u64) -> usize {
-        let mut end = 0;
-        for (i, s) in self.stages.iter().enumerate() {
-            end += s.steps as u64;
-            if step <= end {
-                return i;
-            }
-        }
-        self.stages.len()
-    }
 }
 
 #[cfg(test)]
@@ -285,9 +272,6 @@ mod tests {
         let d = r.displacement_at(150.0);
         assert!((d[0] - 0.04).abs() < 1e-15 && d[1] == -0.02);
         assert_eq!(r.displacement_at(300.0), [0.08, -0.02]);
-        assert_eq!(r.stage_of(50), 0);
-        assert_eq!(r.stage_of(51), 1);
-        assert_eq!(r.stage_of(251), 2);
     }
 
     #[test]

@@ -170,6 +170,16 @@ impl DofMap {
         self.node_global.len()
     }
 
+    /// The particles behind node `n`: a vertex's point twice, or an edge node's two ends.
+    pub fn node_points(&self, n: usize) -> [u32; 2] {
+        let p = self.node_point[n];
+        if p != u32::MAX {
+            [p, p]
+        } else {
+            self.edges[n - (self.n_nodes() - self.edges.len())]
+        }
+    }
+
     /// Dofs of node `n`.
     pub fn ndof(&self, n: usize) -> usize {
         if self.node_point[n] == u32::MAX {
