@@ -48,8 +48,15 @@ impl Plan {
 }
 
 /// Plans refinement of `mesh`. `h[p]` is the spacing of local point p; `protected(p)` marks owned
-/// particles that must neither move nor vanish (tracked, constrained or boundary particles).
-pub fn plan(mesh: &LocalMesh, protected: impl Fn(usize) -> bool, params: &RefineParams) -> Plan {
+/// particles that must neither move nor vanish (tracked or constrained ones). Boundary particles
+/// never move and vanish only where `slides(p)`: on a rigid body's face, where the soil flows
+/// along the body and converging flow would otherwise pile particles up without bound.
+pub fn plan(
+    mesh: &LocalMesh,
+    protected: impl Fn(usize) -> bool,
+    slides: impl Fn(usize) -> bool,
+    params: &RefineParams,
+) -> Plan {
     let n = mesh.n_owned;
     let h = &mesh.h;
     let mut edges: BTreeSet<(u64, u64, u32, u32)> = BTreeSet::new();
@@ -91,6 +98,14 @@ pub fn plan(mesh: &LocalMesh, protected: impl Fn(usize) -> bool, params: &Refine
             }
         }
     }
+    let mut along: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for e in &mesh.boundary_edges {
+        for (p, q) in [(e[0], e[1]), (e[1], e[0])] {
+            if (p as usize) < n {
+                along[p as usize].push(q);
+            }
+        }
+    }
     let mut remove = Vec::new();
     let mut smooth = Vec::new();
     for (p, nb) in neighbours.iter_mut().enumerate() {
@@ -100,6 +115,22 @@ pub fn plan(mesh: &LocalMesh, protected: impl Fn(usize) -> bool, params: &Refine
             continue;
         }
         let pu = p as u32;
+        if mesh.on_boundary[p] {
+            // Only a particle between exactly two boundary neighbours, close to the one with
+            // the smaller id, and whose neighbours stay closer than the split length: the
+            // boundary edge that replaces its two is neither split again nor a shortcut across
+            // a corner.
+            if let [a, c] = along[p][..] {
+                let close = [a, c].iter().any(|&q| {
+                    mesh.gids[q as usize] < mesh.gids[p]
+                        && dist(pu, q) < params.merge_distance * spacing(pu, q)
+                });
+                if close && slides(p) && dist(a, c) < params.split_length * spacing(a, c) {
+                    remove.push(pu);
+                }
+            }
+            continue;
+        }
         let close = nb.iter().any(|&q| {
             mesh.gids[q as usize] < mesh.gids[p]
                 && dist(pu, q) < params.merge_distance * spacing(pu, q)
@@ -166,7 +197,7 @@ mod tests {
     #[test]
     fn regular_lattice_needs_nothing() {
         let m = lattice(6, 5, 0.5, |_| [0.0, 0.0]);
-        let p = plan(&m, |_| false, &RefineParams::default());
+        let p = plan(&m, |_| false, |_| false, &RefineParams::default());
         assert!(p.is_empty(), "{p:?}");
     }
 
@@ -179,7 +210,7 @@ mod tests {
             1.0,
             |i| if i == 12 { [-0.7, 0.0] } else { [0.0, 0.0] },
         );
-        let p = plan(&m, |_| false, &RefineParams::default());
+        let p = plan(&m, |_| false, |_| false, &RefineParams::default());
         assert_eq!(p.remove, vec![12]);
         assert!(!p.split.is_empty(), "the gap left at x = 2 has long edges");
         for [a, b] in &p.split {
@@ -202,10 +233,10 @@ mod tests {
             ..Default::default()
         };
         let lattice = lattice(6, 5, 0.5, |_| [0.0, 0.0]);
-        assert!(plan(&lattice, |_| false, &params).is_empty());
+        assert!(plan(&lattice, |_| false, |_| false, &params).is_empty());
 
         let m = lattice_with(12, [0.58, 0.0]);
-        let p = plan(&m, |_| false, &params);
+        let p = plan(&m, |_| false, |_| false, &params);
         assert!(p.smooth.iter().all(|(i, _)| !m.on_boundary[*i as usize]));
         let (_, target) = p
             .smooth
@@ -220,8 +251,26 @@ mod tests {
             after > before,
             "smoothing must improve the worst angle: {before} -> {after}"
         );
-        let none = plan(&m, |i| i == 12, &params);
+        let none = plan(&m, |i| i == 12, |_| false, &params);
         assert!(none.smooth.iter().all(|(i, _)| *i != 12));
+    }
+
+    #[test]
+    fn boundary_particles_merge_only_where_they_slide() {
+        // Bottom row: particle 2 crowds particle 1, particle 3 closes the gap it would leave.
+        let m = lattice(5, 5, 1.0, |i| match i {
+            2 => [-0.7, 0.0],
+            3 => [-0.5, 0.0],
+            _ => [0.0, 0.0],
+        });
+        assert!(m.on_boundary[2]);
+        let params = RefineParams::default();
+        assert!(plan(&m, |_| false, |_| false, &params).remove.is_empty());
+        assert_eq!(plan(&m, |_| false, |_| true, &params).remove, vec![2]);
+        assert!(plan(&m, |i| i == 2, |_| true, &params).remove.is_empty());
+        // Without particle 3 closing in, removing 2 would leave an edge to split at once.
+        let gap = lattice_with(2, [-0.7, 0.0]);
+        assert!(plan(&gap, |_| false, |_| true, &params).remove.is_empty());
     }
 
     fn lattice_with(moved: usize, by: [f64; 2]) -> LocalMesh {

@@ -220,12 +220,16 @@ impl Simulation {
         }
         let local = worst.map_or(0.0, |w| w.0.max(0.0));
         let deepest = pfem_partition::max_f64(world, local);
-        let message = worst.filter(|w| w.0 > PENETRATION_LIMIT).map(|(d, gid, bi)| {
-            format!(
-                "step {}: particle {gid} is inside rigid body '{}' by {d:.3} of its spacing                  (limit {PENETRATION_LIMIT}): the soil passed through the body; try a larger                  contact.penalty or more steps",
-                self.header.step, self.model.bodies[bi].name
-            )
-        });
+        let message = worst
+            .filter(|w| w.0 > PENETRATION_LIMIT)
+            .map(|(d, gid, bi)| {
+                format!(
+                    "step {}: particle {gid} is inside rigid body '{}' by {d:.3} of its spacing \
+                 (limit {PENETRATION_LIMIT}): the soil passed through the body; try a larger \
+                 contact.penalty or more steps",
+                    self.header.step, self.model.bodies[bi].name
+                )
+            });
         match pfem_partition::agree_on_error(world, message) {
             Some(e) => Err(e),
             None => Ok(deepest),

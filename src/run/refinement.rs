@@ -12,6 +12,9 @@ use std::collections::HashSet;
 
 const K: usize = GaussState::LEN;
 
+/// A boundary particle this close to a rigid body (in its spacing) slides on it.
+const SLIDING_GAP: f64 = 0.1;
+
 impl Simulation {
     /// Collective. Inserts, removes and smooths particles as the scene asks; returns whether
     /// anything changed anywhere (then the mesh must be rebuilt).
@@ -26,7 +29,6 @@ impl Simulation {
         };
         let protected = |p: usize| {
             self.particles.flags[p] & flag::TRACKED != 0
-                || mesh.on_boundary[p]
                 || self
                     .model
                     .step_bc(
@@ -38,7 +40,14 @@ impl Simulation {
                     .iter()
                     .any(Option::is_some)
         };
-        let mut plan = plan(mesh, protected, &params);
+        let lambda = self.header.load_factor;
+        let bodies: Vec<_> = self.model.bodies.iter().map(|b| b.shape(lambda)).collect();
+        let slides = |p: usize| {
+            bodies
+                .iter()
+                .any(|s| s.closest(mesh.points[p]).distance <= SLIDING_GAP * mesh.h[p])
+        };
+        let mut plan = plan(mesh, protected, slides, &params);
         if !settings.refine {
             plan.split.clear();
             plan.remove.clear();
