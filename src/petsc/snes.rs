@@ -50,7 +50,7 @@ struct Ctx<'a> {
 /// Newton has stalled when its residual fell by less than [`STALL_FACTOR`] over this many
 /// iterations: a stuck backtracking line search creeps on for the rest of `max_it` (60
 /// iterations, half a minute on the T-bar) before a cut step that converges in ten.
-const STALL_WINDOW: usize = 12;
+const STALL_WINDOW: usize = 25;
 const STALL_FACTOR: f64 = 0.5;
 
 const PETSC_ERR_USER: ffi::PetscErrorCode = 83;

@@ -117,10 +117,25 @@ impl Simulation {
             };
             let (sa, sb) = (value(a), value(b));
             let state: [f64; K] = std::array::from_fn(|k| 0.5 * (sa[k] + sb[k]));
+            let (mut x, mut u) = (mid(mesh.points[a], mesh.points[b]), mid(disp(a), disp(b)));
+            // A boundary chord round a body's corner cuts into the body: its new particle goes
+            // onto the body's surface, where the soil it stands for is, instead of starting
+            // inside and held there by the contact's start offset.
+            if mesh.on_boundary[a] && mesh.on_boundary[b] {
+                for shape in &bodies {
+                    let prox = shape.closest(x);
+                    if prox.distance < 0.0 {
+                        for k in 0..2 {
+                            x[k] -= prox.distance * prox.normal[k];
+                            u[k] -= prox.distance * prox.normal[k];
+                        }
+                    }
+                }
+            }
             born.push((
                 first_new + rank as u64,
-                mid(mesh.points[a], mesh.points[b]),
-                mid(disp(a), disp(b)),
+                x,
+                u,
                 mid(incr(a), incr(b)),
                 0.5 * (mesh.h[a] + mesh.h[b]),
                 state,
