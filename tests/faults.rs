@@ -88,3 +88,75 @@ fn new_refuses_to_replace_what_is_not_a_case_file() {
         "the scene file must be left as it was"
     );
 }
+
+#[test]
+fn plot_of_a_blown_up_history_finishes_and_says_what_it_left_out() {
+    let dir = workdir("faults-plot");
+    let run = dir.join("run");
+    std::fs::create_dir(&run).unwrap();
+    std::fs::write(
+        run.join("history.csv"),
+        "step,lambda,u_over_L,v_over_L\n1,0.5,0.01,0.1\n2,1e308,1e308,-1e308\n3,1e-320,2e-320,0\n",
+    )
+    .unwrap();
+    let (ok, stderr) = run_limited(&dir, &["plot", "run"], Duration::from_secs(60));
+    assert!(ok, "{stderr}");
+    assert!(
+        stderr.contains("3 value(s) beyond ±1e100 left out of history.png")
+            && stderr.contains("row 2, column lambda = 1e308"),
+        "{stderr}"
+    );
+    assert!(run.join("plots/history.png").is_file());
+}
+
+#[test]
+fn runs_that_would_do_nothing_or_mix_cases_are_refused() {
+    let dir = workdir("faults-run");
+    let case = ["new", "cantilever", "--set", "mesh.h=0.5", "-o"];
+    ok(
+        &dir,
+        1,
+        &[&case[..], &["c.h5", "--set", "steps.count=3"]].concat(),
+    );
+    refused(
+        &dir,
+        &["c.h5", "--until-step", "0"],
+        &["--until-step 0: nothing to run", "give a step from 1 to 3"],
+    );
+    assert!(!dir.join("c.out").exists(), "nothing may be written");
+    ok(&dir, 1, &["c.h5", "--until-step", "2"]);
+    refused(
+        &dir,
+        &["c.out/checkpoints/step_000002.h5", "--until-step", "1"],
+        &["--until-step 1: nothing to run", "already at step 2"],
+    );
+
+    ok(
+        &dir,
+        1,
+        &[&case[..], &["d.h5", "--set", "steps.count=4"]].concat(),
+    );
+    refused(
+        &dir,
+        &["d.h5", "--out", "c.out"],
+        &["c.out: holds the output of another case"],
+    );
+    let kept: Vec<_> = std::fs::read_dir(dir.join("c.out/checkpoints"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(kept, ["step_000002.h5"], "the other run's checkpoints stay");
+    // The same case continues in its own folder.
+    ok(&dir, 1, &["c.out/checkpoints/step_000002.h5"]);
+
+    refused(
+        &dir,
+        &["d.h5", "--out", "p", "--", "-snes_max_it", "abc"],
+        &["SNESSetFromOptions", "-snes_max_it abc"],
+    );
+    refused(
+        &dir,
+        &["d.h5", "--out", "p", "--", "-pc_type", "nosuch"],
+        &["PC type nosuch"],
+    );
+}
