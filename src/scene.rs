@@ -63,6 +63,8 @@ pub mod schema;
 pub mod selector;
 #[path = "scene/validate.rs"]
 mod validate;
+#[path = "scene/validate_fine.rs"]
+mod validate_fine;
 #[path = "scene/validate_rigid.rs"]
 pub mod validate_rigid;
 #[path = "scene/value_de.rs"]

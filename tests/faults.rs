@@ -160,3 +160,47 @@ fn runs_that_would_do_nothing_or_mix_cases_are_refused() {
         &["PC type nosuch"],
     );
 }
+
+#[test]
+fn scene_limits_hold_before_any_particle_is_made() {
+    let dir = workdir("faults-limits");
+    let new = |set: &str, needles: &[&str]| {
+        refused(
+            &dir,
+            &["new", "cantilever", "-o", "bad.h5", "--set", set],
+            needles,
+        );
+        assert!(!dir.join("bad.h5").exists());
+    };
+    // Counted from the areas: before the check, this grew without bound.
+    new(
+        "mesh.fine=[{origin=[0.0,0.0],size=[1.0,1.0],h=1e-6}]",
+        &["mesh.fine[0].h", "1.000e12 particles", "limit of 50000000"],
+    );
+    new("mesh.h=1e-4", &["mesh.h", "limit of 50000000", "7 GB"]);
+    new("mesh.alpha=1e6", &["mesh.alpha", "must be <= 2"]);
+    new(
+        "mesh.fine=[{origin=[20.0,20.0],size=[1.0,1.0],h=0.0625}]",
+        &["mesh.fine[0]", "outside the body"],
+    );
+    new(
+        "mesh.fine=[{origin=[0.0,0.0],size=[1.0,1.0],h=0.1}]",
+        &[
+            "mesh.fine[0].h",
+            "not a whole fraction of the coarser spacing 0.125",
+        ],
+    );
+    new(
+        "mesh.fine=[{origin=[0.0,0.0],size=[1.0,1.0],h=0.0625},\
+         {origin=[0.0,0.0],size=[0.5,0.5],h=0.025}]",
+        &["mesh.fine[1].h", "coarser spacing 0.0625"],
+    );
+    new(
+        "mesh.fine=[{origin=[0.1,0.0],size=[1.0,1.0],h=0.0625}]",
+        &["mesh.fine[0].origin", "must be a whole number"],
+    );
+    new(
+        "mesh.h=0.5\nsteps.count=3",
+        &["contains a line break", "one value, on one line"],
+    );
+}
