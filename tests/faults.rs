@@ -204,3 +204,78 @@ fn scene_limits_hold_before_any_particle_is_made() {
         &["contains a line break", "one value, on one line"],
     );
 }
+
+#[test]
+fn a_run_that_lost_its_body_is_an_error_not_done() {
+    let dir = workdir("faults-lost-body");
+    // The platens driven through each other: from step 4 no triangle is left.
+    ok(
+        &dir,
+        1,
+        &[
+            "new",
+            "block-compression",
+            "-o",
+            "b.h5",
+            "--set",
+            "prescribed[0].total=[0.0,-3.0]",
+            "--set",
+            "prescribed[1].total=[0.0,3.0]",
+            "--set",
+            "steps.count=20",
+            "--set",
+            "mesh.refine=false",
+        ],
+    );
+    refused(
+        &dir,
+        &["b.h5"],
+        &[
+            "step 4: the mesh has no triangle left",
+            "stops before writing",
+        ],
+    );
+    let (_, rows) = history(&dir.join("b.out/history.csv"));
+    assert_eq!(rows.len(), 3, "the empty step is not recorded");
+}
+
+#[test]
+fn a_point_load_on_no_particle_is_an_error() {
+    let dir = workdir("faults-lost-load");
+    ok(
+        &dir,
+        1,
+        &[
+            "new",
+            "cantilever",
+            "-o",
+            "c.h5",
+            "--set",
+            "mesh.h=0.5",
+            "--set",
+            "steps.count=2",
+        ],
+    );
+    // The tracked particle renamed to an id no particle has: the load was dropped silently.
+    let edit = "import h5py, sys\nf = h5py.File(sys.argv[1], 'r+')\n\
+                f.attrs.modify('tracked_gids', [10**6])\nf.close()\n";
+    match Command::new("python3")
+        .args(["-c", edit, "c.h5"])
+        .current_dir(&dir)
+        .output()
+    {
+        Ok(o) if o.status.success() => {}
+        other => {
+            println!("skipped: python3 with h5py is needed to edit the case file ({other:?})");
+            return;
+        }
+    }
+    refused(
+        &dir,
+        &["c.h5"],
+        &[
+            "step 1: point_load[0] at [10, 0.5] does not reach the body",
+            "gid 1000000",
+        ],
+    );
+}

@@ -39,6 +39,7 @@ pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), String>
         let mut mesh = t.time("remesh", || sim.remesh(world))?;
         let states = t.time("map", || sim.map(&mesh));
         let report = t.time("solve", || sim.advance(world, petsc, &mut mesh, states))?;
+        sanity::check_step(world, &sim, &mesh, &report)?;
         if stop.requested(world) {
             last = sim.step();
         }
