@@ -29,6 +29,8 @@
 mod collective;
 #[path = "case_file/datasets.rs"]
 mod datasets;
+#[path = "case_file/destination.rs"]
+mod destination;
 #[path = "case_file/error.rs"]
 mod error;
 #[path = "case_file/ffi.rs"]
@@ -288,6 +290,7 @@ pub fn write_checkpoint(
         .check_lengths()
         .map_err(|m| CaseError::new(path, CaseErrorKind::InvalidInput, m));
     agree(comm, path, checked)?;
+    check_output(comm, path, None)?;
 
     let count = local.len() as u64;
     let mut inclusive = 0u64;
@@ -368,6 +371,21 @@ pub fn write_checkpoint(
         Ok(())
     };
     agree(comm, path, renamed)
+}
+
+/// Collective. Refuses, on every rank, an output `path` that is not a regular file (or absent)
+/// or that is the file `input` being read; rank 0 looks, as rank 0 renames.
+pub fn check_output(
+    comm: &SimpleCommunicator,
+    path: &Path,
+    input: Option<&Path>,
+) -> Result<(), CaseError> {
+    let checked = if comm.rank() == 0 {
+        destination::check_destination(path, input)
+    } else {
+        Ok(())
+    };
+    agree(comm, path, checked)
 }
 
 fn read_contents(

@@ -1,12 +1,12 @@
 //! The subcommands. Every one is collective: all ranks run it and all ranks exit with the same
 //! code; the error is printed once, by rank 0.
 
-use crate::case_file::{new_case, summarize, write_case};
+use crate::case_file::{check_output, new_case, summarize, write_case};
 use crate::cli::{default_out_dir, Command};
 use crate::mesh::fingerprint::fingerprint;
 use crate::petsc::Petsc;
 use crate::run::{run, RunOptions, Simulation};
-use crate::scene::load_scene;
+use crate::scene::{load_scene, scene_file};
 use mpi::traits::Communicator;
 use pfem_partition::{agree_on_error, gather_to_root, sum_f64, Comm};
 
@@ -64,8 +64,10 @@ pub fn execute(command: Command) -> i32 {
     }
 }
 
-/// Collective. Rank 0 generates the particles; all ranks write the file together.
+/// Collective. Rank 0 generates the particles; all ranks write the file together. The output
+/// is checked first, so a refused destination costs no particle generation.
 fn new(world: &Comm, scene: &str, out: &std::path::Path, sets: &[String]) -> Result<(), String> {
+    check_output(world, out, scene_file(scene)).map_err(|e| e.to_string())?;
     let (scene_v, _toml) = load_scene(scene, sets).map_err(|e| e.to_string())?;
     let (header, mut set) = new_case(&scene_v, scene);
     if world.rank() != 0 {

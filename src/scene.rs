@@ -63,6 +63,8 @@ pub mod schema;
 pub mod selector;
 #[path = "scene/validate.rs"]
 mod validate;
+#[path = "scene/validate_fine.rs"]
+mod validate_fine;
 #[path = "scene/validate_rigid.rs"]
 pub mod validate_rigid;
 #[path = "scene/value_de.rs"]
@@ -189,16 +191,24 @@ impl Scene {
     }
 }
 
+/// The file [`load_scene`] reads for `name_or_path`, or `None` when it names a built-in (or
+/// nothing).
+pub fn scene_file(name_or_path: &str) -> Option<&Path> {
+    let is_path = name_or_path.ends_with(".toml")
+        || name_or_path.contains('/')
+        || name_or_path.contains(std::path::MAIN_SEPARATOR);
+    let exists = Path::new(name_or_path).exists();
+    let builtin = builtin(name_or_path).is_some();
+    (is_path || (!builtin && exists)).then(|| Path::new(name_or_path))
+}
+
 /// Loads a built-in scene by name or a scene file by path (anything ending in `.toml` or
 /// containing a `/` is a path), applies `--set` overrides and validates. Returns the scene and
 /// its resolved TOML (overrides and defaults applied), which is what a case file records.
 pub fn load_scene(name_or_path: &str, sets: &[String]) -> Result<(Scene, String), SceneError> {
-    let is_path = name_or_path.ends_with(".toml")
-        || name_or_path.contains('/')
-        || name_or_path.contains(std::path::MAIN_SEPARATOR);
     let text: Cow<'static, str> = match builtin(name_or_path) {
-        Some(text) if !is_path => Cow::Borrowed(text),
-        _ if !is_path && !Path::new(name_or_path).exists() => {
+        Some(text) if scene_file(name_or_path).is_none() => Cow::Borrowed(text),
+        None if scene_file(name_or_path).is_none() => {
             return Err(SceneError::new(
                 name_or_path,
                 format!(

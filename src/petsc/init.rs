@@ -3,6 +3,15 @@ use super::ffi;
 use mpi::raw::AsRaw;
 use mpi::topology::SimpleCommunicator;
 use std::ffi::{c_char, c_int, CString};
+use std::sync::OnceLock;
+
+/// The PETSc options of the command line, for messages about options PETSc rejected.
+static USER_OPTIONS: OnceLock<String> = OnceLock::new();
+
+/// The PETSc options given on the command line (after `--`), space-separated; empty if none.
+pub(crate) fn user_options() -> &'static str {
+    USER_OPTIONS.get().map_or("", String::as_str)
+}
 
 /// PETSc's lifetime. Create after rsmpi initialised MPI, drop before rsmpi's `Universe`: PETSc then
 /// neither initialises nor finalises MPI itself.
@@ -16,6 +25,7 @@ impl Petsc {
     /// Collective. `options` are PETSc command-line options (e.g. `-snes_monitor`), passed through
     /// unchanged so every PETSc option works at run time.
     pub fn initialize(world: &SimpleCommunicator, options: &[String]) -> Result<Petsc, PetscError> {
+        let _ = USER_OPTIONS.set(options.join(" "));
         let mut args = vec![CString::new("pfem-mpi").unwrap_or_default()];
         for o in options {
             args.push(CString::new(o.as_str()).map_err(|_| PetscError {

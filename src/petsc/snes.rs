@@ -107,7 +107,8 @@ impl Snes {
                 ffi::SNESLineSearchSetType(ls, kind.as_ptr()),
                 "SNESLineSearchSetType",
             )?;
-            check(ffi::SNESSetFromOptions(raw), "SNESSetFromOptions")?;
+            check(ffi::SNESSetFromOptions(raw), "SNESSetFromOptions")
+                .map_err(PetscError::naming_user_options)?;
             Ok(snes)
         }
     }

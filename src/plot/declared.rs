@@ -8,7 +8,7 @@ use plotters::style::RGBColor;
 
 use crate::scene::{ReferenceLine, Scene};
 
-use super::history::History;
+use super::history::{drawable, History};
 use super::legacy::CURVE_SIZE;
 use super::numbers::short;
 use super::panel::{draw_panel, Curve, Look, Panel, REFERENCE_HIGH, REFERENCE_LOW, RESULT_U};
@@ -50,10 +50,10 @@ pub(crate) fn x_column(history: &History) -> usize {
     }
 }
 
-/// Whether the finite `values` strictly rise or strictly fall. Non-finite values are skipped:
-/// those steps diverged and are left out of the curves as well.
+/// Whether the drawable `values` strictly rise or strictly fall. Others are skipped: those steps
+/// diverged and are left out of the curves as well.
 fn strictly_monotonic(values: &[f64]) -> bool {
-    let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
+    let finite: Vec<f64> = values.iter().copied().filter(|&v| drawable(v)).collect();
     finite.windows(2).all(|w| w[1] > w[0]) || finite.windows(2).all(|w| w[1] < w[0])
 }
 
@@ -84,7 +84,7 @@ fn reference_label(line: &ReferenceLine) -> String {
 /// zero, but a quantity far from zero (an area, a ratio near 1) would be squashed flat.
 fn reaches_zero(values: impl Iterator<Item = f64>) -> bool {
     let (lo, hi) = values
-        .filter(|v| v.is_finite())
+        .filter(|&v| drawable(v))
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
             (lo.min(v), hi.max(v))
         });

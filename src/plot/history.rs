@@ -14,6 +14,16 @@ const KINDS: [HistoryKind; 3] = [
     HistoryKind::Block,
 ];
 
+/// Largest magnitude drawn. A value beyond it is a step that blew up, not a result to read off a
+/// chart; and drawing it would fail: plotters computes axis ticks forever on an infinite range
+/// (1e308 - -1e308 overflows) and its line rasteriser overflows on points far off the chart.
+pub(crate) const DRAWABLE: f64 = 1e100;
+
+/// Whether `v` can be drawn: finite and within [`DRAWABLE`].
+pub(crate) fn drawable(v: f64) -> bool {
+    v.is_finite() && v.abs() <= DRAWABLE
+}
+
 /// The columns and rows of a history file.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct History {
@@ -51,14 +61,29 @@ impl History {
         }
     }
 
-    /// The curve of column `iy` against column `ix`, in file order. Points with a non-finite
-    /// value (a step that diverged writes NaN) are left out.
+    /// The curve of column `iy` against column `ix`, in file order. Points with a value that
+    /// cannot be [`drawable`] (a step that diverged writes NaN) are left out.
     pub fn curve_at(&self, ix: usize, iy: usize) -> Vec<(f64, f64)> {
         self.rows
             .iter()
             .map(|r| (r[ix], r[iy]))
-            .filter(|(a, b)| a.is_finite() && b.is_finite())
+            .filter(|&(a, b)| drawable(a) && drawable(b))
             .collect()
+    }
+
+    /// How many finite values lie beyond [`DRAWABLE`], and the first of them as
+    /// `line L, column C = V`, for the warning that they are left out of the picture.
+    pub fn undrawable(&self) -> Option<(usize, String)> {
+        let mut found = self.rows.iter().enumerate().flat_map(|(r, row)| {
+            row.iter()
+                .enumerate()
+                .filter(|(_, v)| v.is_finite() && !drawable(**v))
+                .map(move |(c, v)| (r, c, *v))
+        });
+        let (r, c, v) = found.next()?;
+        // The header is line 1; blank lines are not counted, so this is the row's place.
+        let first = format!("row {}, column {} = {v:e}", r + 1, self.names[c]);
+        Some((1 + found.count(), first))
     }
 }
 

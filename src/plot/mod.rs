@@ -56,10 +56,21 @@ pub use legacy::{BLOCK_SIZE, CURVE_SIZE};
 /// All inputs are read before any picture is written. Errors name the file at fault: a missing
 /// or malformed `history.csv`, a damaged `fields.xdmf`, a frame file that cannot be read or
 /// lacks a field, or a picture that cannot be written. A `scene.toml` that cannot be read or
-/// parsed is no error: a warning on stderr, and the history is drawn as without one.
+/// parsed is no error: a warning on stderr, and the history is drawn as without one. Values
+/// that are not finite or beyond `history::DRAWABLE` are left out of the curves, the latter
+/// with a warning on stderr.
 pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
     font::register()?;
-    let history = history::read(&dir.join("history.csv"))?;
+    let history_file = dir.join("history.csv");
+    let history = history::read(&history_file)?;
+    if let Some((count, first)) = history.undrawable() {
+        eprintln!(
+            "pfem-mpi: warning: {}: {count} value(s) beyond ±{:e} left out of history.png \
+             (first: {first})",
+            history_file.display(),
+            history::DRAWABLE
+        );
+    }
     let scene = scene_file::read(dir);
     let frame = frame::last_frame(dir)?;
     let mut fields = Vec::new();

@@ -6,6 +6,7 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::font::FAMILY;
+use super::history::drawable;
 
 /// A run's results get markers while they are this sparse; denser runs are a plain line.
 const MAX_MARKED: usize = 60;
@@ -57,11 +58,13 @@ pub(super) struct Panel {
     pub y_from_zero: bool,
 }
 
-/// Range of `values`, widened to hold 0 when `with_zero`, padded by 4 % on a side not at zero,
-/// never empty.
+/// Range of the [`drawable`] `values`, widened to hold 0 when `with_zero`, padded by 4 % on a
+/// side not at zero, never empty, always finite. Magnitudes below 1e-100 count as 0, so that
+/// the tick spacing stays a normal number.
 pub(super) fn span(values: impl Iterator<Item = f64>, with_zero: bool) -> (f64, f64) {
     let (mut lo, mut hi) = values
-        .filter(|v| v.is_finite())
+        .filter(|&v| drawable(v))
+        .map(|v| if v.abs() < 1e-100 { 0.0 } else { v })
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
             (lo.min(v), hi.max(v))
         });
@@ -242,5 +245,9 @@ mod tests {
         assert!(lo < 0.91 && hi > 1.09);
         assert_eq!(span(std::iter::empty(), false), (0.0, 1.0));
         assert_eq!(span([f64::NAN].into_iter(), true), (0.0, 1.04));
+        let (lo, hi) = span([1.0, 1e308, -1e308, 2.0].into_iter(), false);
+        assert!((lo - 0.96).abs() < 1e-12 && (hi - 2.04).abs() < 1e-12);
+        let (lo, hi) = span([1e-310, 2e-310].into_iter(), false);
+        assert_eq!((lo, hi), (-0.04, 1.04));
     }
 }

@@ -5,6 +5,7 @@ mod output;
 mod progress;
 mod refinement;
 mod restart;
+mod sanity;
 mod signals;
 mod simulation;
 mod step;
@@ -29,6 +30,7 @@ pub struct RunOptions {
 pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), String> {
     let stop = signals::StopRequest::install()?;
     let mut sim = Simulation::load(world, &opts.case)?;
+    sanity::check_until_step(opts, &sim)?;
     let mut out = output::Output::open(world, &sim, &opts.out_dir)?;
     let mut progress = Progress::new(world, sim.total_steps());
     let mut last = opts.until_step.unwrap_or(u64::MAX).min(sim.total_steps());
@@ -37,6 +39,7 @@ pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), String>
         let mut mesh = t.time("remesh", || sim.remesh(world))?;
         let states = t.time("map", || sim.map(&mesh));
         let report = t.time("solve", || sim.advance(world, petsc, &mut mesh, states))?;
+        sanity::check_step(world, &sim, &mesh, &report)?;
         if stop.requested(world) {
             last = sim.step();
         }

@@ -26,15 +26,37 @@ fn write_scene(dir: &Path, sim: &Simulation) -> Result<(), String> {
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 
+/// Refuses a folder that holds another case's run: its checkpoints, history and fields would be
+/// mixed with this one's, and pruning would delete the other run's checkpoints. The folder's
+/// `scene.toml` tells: a continuation of the same case has the same scene.
+fn check_same_case(dir: &Path, sim: &Simulation) -> Result<(), String> {
+    let path = dir.join("scene.toml");
+    let Ok(text) = std::fs::read_to_string(&path) else {
+        return Ok(());
+    };
+    let name = path.display().to_string();
+    match crate::scene::Scene::from_toml(&text, &name, &[]) {
+        Ok(scene) if &scene == sim.scene() => Ok(()),
+        _ => Err(format!(
+            "{}: holds the output of another case ({name} is not this case's scene); give \
+             another --out folder, or remove this one to start over",
+            dir.display()
+        )),
+    }
+}
+
 impl Output {
     /// Collective. Creates `DIR` (rank 0) and opens the history, keeping rows of earlier runs up to
-    /// the restart step.
+    /// the restart step. A `DIR` holding another case's run is refused.
     pub fn open(world: &Comm, sim: &Simulation, dir: &Path) -> Result<Output, String> {
         let mut local = None;
         let mut history = None;
         if world.rank() == 0 {
-            match std::fs::create_dir_all(dir.join("checkpoints"))
-                .map_err(|e| format!("{}: {e}", dir.display()))
+            match check_same_case(dir, sim)
+                .and_then(|_| {
+                    std::fs::create_dir_all(dir.join("checkpoints"))
+                        .map_err(|e| format!("{}: {e}", dir.display()))
+                })
                 .and_then(|_| write_scene(dir, sim))
                 .and_then(|_| HistoryFile::open(dir, sim.scene(), sim.step()))
             {

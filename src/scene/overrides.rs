@@ -50,6 +50,13 @@ fn parse_path(text: &str) -> Result<FieldPath, String> {
 
 fn parse_value(text: &str) -> Result<Value, String> {
     let text = text.trim();
+    // The value is parsed as the line `v = VALUE`: a line break would let it go on with more
+    // `key = value` lines, which were silently dropped.
+    if text.contains(['\n', '\r']) {
+        return Err(format!(
+            "the value {text:?} contains a line break; give one value, on one line, per --set"
+        ));
+    }
     match format!("v = {text}").parse::<toml::Table>() {
         Ok(mut t) => t
             .remove("v")

@@ -9,8 +9,17 @@ use super::schema::{Dof, HistoryKind, MaterialModel, Scene, Selection};
 use super::selector::{Axis, Selector};
 
 /// Upper bound on the initial particle count, so that a mistyped `mesh.h` is reported instead
-/// of exhausting memory.
-pub const MAX_PARTICLES: u64 = 1_000_000_000;
+/// of exhausting memory or disk: `new` builds the whole lattice in one process, and a particle
+/// takes 140 bytes in memory and in the case file (`gid`, `position`, `displacement`,
+/// `increment`, `h`, 9 state values, `flags`), so the limit is a 7 GB case file.
+pub const MAX_PARTICLES: u64 = 50_000_000;
+/// Why [`MAX_PARTICLES`] is what it is, for the error message.
+pub const LIMIT_REASON: &str =
+    "140 bytes a particle: a 7 GB case file, built in one process by `pfem-mpi new`";
+/// Largest `mesh.alpha`: the alpha shape keeps triangles of circumradius up to alpha * h, so it
+/// joins boundaries up to 2 alpha h apart; beyond 2 it bridges gaps of 4 h and fills concave
+/// corners, which stiffens the body (PFEM practice is 1.2 to 1.5).
+pub const MAX_ALPHA: f64 = 2.0;
 
 pub type Invalid = (FieldPath, String);
 
@@ -116,6 +125,17 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
             format!(
                 "must be >= 0.7071 (got {}): smaller values delete every triangle of the \
                  square particle lattice",
+                s.mesh.alpha
+            ),
+        );
+    }
+    if s.mesh.alpha > MAX_ALPHA {
+        return fail(
+            mesh.join("alpha"),
+            format!(
+                "must be <= {MAX_ALPHA} (got {}): the alpha shape would keep triangles across \
+                 gaps of up to 2 alpha h and fill concave corners, stiffening the body \
+                 (usual values 1.2 to 1.5)",
                 s.mesh.alpha
             ),
         );
@@ -265,14 +285,14 @@ fn check_alignment(s: &Scene) -> Result<(), Invalid> {
         .body
         .rectangles
         .iter()
-        .map(|r| (r.size[0] / h + 1.0) * (r.size[1] / h + 1.0))
+        .map(|r| super::validate_fine::lattice_count(r.size, h))
         .sum();
     if upper > MAX_PARTICLES as f64 {
         return fail(
             FieldPath::key("mesh").join("h"),
             format!(
                 "h = {h} would create about {upper:.3e} particles, more than the limit of \
-                 {MAX_PARTICLES}"
+                 {MAX_PARTICLES} ({LIMIT_REASON})"
             ),
         );
     }
@@ -330,5 +350,6 @@ pub fn validate(s: &Scene) -> Result<(), Invalid> {
     check_fields(s)?;
     super::validate_rigid::check(s)?;
     check_alignment(s)?;
+    super::validate_fine::check(s)?;
     check_against_particles(s)
 }

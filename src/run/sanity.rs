@@ -1,0 +1,142 @@
+//! Checks that a run does what it was asked and that what it reports means something: a
+//! request that would run no step, or a step that went through on a body that is gone (no
+//! triangle left, its area collapsed, a point load on a particle the mesh no longer holds),
+//! where the solver has nothing left to fail on and would report success.
+
+use super::{RunOptions, Simulation, StepReport};
+use crate::mesh::LocalMesh;
+use crate::scene::Scene;
+use pfem_partition::{sum_f64, Comm};
+
+/// Smallest body area, as a fraction of the scene's, that a step may end with. Plastic flow
+/// and remeshing change a body's area by a few per cent; an area halved means the body was
+/// crushed, inverted or torn away by the alpha shape, and its stresses mean nothing.
+pub(super) const MIN_AREA_RATIO: f64 = 0.5;
+
+/// Refuses an `--until-step` that leaves nothing to run: 0, or a step the case has already
+/// reached. Not collective: every rank holds the same header, so every rank agrees.
+pub(super) fn check_until_step(opts: &RunOptions, sim: &Simulation) -> Result<(), String> {
+    let Some(until) = opts.until_step else {
+        return Ok(());
+    };
+    let (step, total) = (sim.step(), sim.total_steps());
+    if until > step {
+        return Ok(());
+    }
+    let why = if until == 0 {
+        "a run stops after a step it has made".to_string()
+    } else {
+        format!("{} is already at step {step}", opts.case.display())
+    };
+    let instead = if step < total {
+        format!("give a step from {} to {total} (steps.count)", step + 1)
+    } else {
+        format!("the case has made all its steps (steps.count = {total})")
+    };
+    Err(format!(
+        "--until-step {until}: nothing to run, {why}; {instead}"
+    ))
+}
+
+/// Area of the union of the scene's body rectangles (overlaps counted once).
+fn body_area(scene: &Scene) -> f64 {
+    let rects = &scene.body.rectangles;
+    let mut xs: Vec<f64> = rects
+        .iter()
+        .flat_map(|r| [r.origin[0], r.origin[0] + r.size[0]])
+        .collect();
+    let mut ys: Vec<f64> = rects
+        .iter()
+        .flat_map(|r| [r.origin[1], r.origin[1] + r.size[1]])
+        .collect();
+    xs.sort_by(f64::total_cmp);
+    ys.sort_by(f64::total_cmp);
+    let mut area = 0.0;
+    for x in xs.windows(2) {
+        for y in ys.windows(2) {
+            let mid = [0.5 * (x[0] + x[1]), 0.5 * (y[0] + y[1])];
+            let covered = rects
+                .iter()
+                .any(|r| (0..2).all(|c| mid[c] > r.origin[c] && mid[c] < r.origin[c] + r.size[c]));
+            if covered {
+                area += (x[1] - x[0]) * (y[1] - y[0]);
+            }
+        }
+    }
+    area
+}
+
+/// Whether this rank holds particle `gid` as a vertex of one of its triangles.
+fn holds_in_a_triangle(mesh: &LocalMesh, gid: u64) -> bool {
+    let Some(i) = mesh.gids[..mesh.n_owned].iter().position(|&g| g == gid) else {
+        return false;
+    };
+    let i = i as u32;
+    mesh.tris.iter().any(|t| t.contains(&i))
+}
+
+/// Collective. After a step solved on `mesh`: an error when the mesh had no triangle, when the
+/// body's area fell below [`MIN_AREA_RATIO`] of the scene's, or when a `[[point_load]]`'s
+/// particle was in no triangle (the load was not applied). The same verdict on every rank.
+pub(super) fn check_step(
+    world: &Comm,
+    sim: &Simulation,
+    mesh: &LocalMesh,
+    report: &StepReport,
+) -> Result<(), String> {
+    let scene = sim.scene();
+    let step = sim.step();
+    let loads = &scene.point_load;
+    let mut local = vec![sim.last_area];
+    local.extend(loads.iter().enumerate().map(|(k, _)| {
+        let held = sim
+            .header
+            .tracked_gids
+            .get(k)
+            .is_some_and(|&g| holds_in_a_triangle(mesh, g));
+        f64::from(u8::from(held))
+    }));
+    let global = sum_f64(world, &local);
+    let stop = "the run stops before writing this step";
+    if report.triangles == 0 {
+        return Err(format!(
+            "step {step}: the mesh has no triangle left: the body was crushed or torn apart \
+             (no particles within alpha * h of each other); {stop}"
+        ));
+    }
+    let ratio = global[0] / body_area(scene);
+    if ratio.is_nan() || ratio < MIN_AREA_RATIO {
+        return Err(format!(
+            "step {step}: the body's area is {ratio:.3} of its initial area (limit \
+             {MIN_AREA_RATIO}): it was crushed or inverted; {stop}"
+        ));
+    }
+    if let Some(k) = global[1..].iter().position(|&held| held == 0.0) {
+        let particle = match sim.header.tracked_gids.get(k) {
+            Some(g) => format!("its particle (gid {g}) is in no triangle of the mesh"),
+            None => "the case file's tracked_gids names no particle for it".to_string(),
+        };
+        return Err(format!(
+            "step {step}: point_load[{k}] at [{}, {}] does not reach the body: {particle}, so \
+             the load was not applied; {stop}",
+            loads[k].at[0], loads[k].at[1]
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn body_area_counts_overlaps_once() {
+        let (mut scene, _) = crate::scene::load_scene("cantilever", &[]).unwrap();
+        assert_eq!(body_area(&scene), 10.0);
+        let mut r = scene.body.rectangles[0];
+        r.origin = [9.0, 0.0];
+        r.size = [2.0, 2.0];
+        scene.body.rectangles.push(r);
+        assert_eq!(body_area(&scene), 10.0 + 2.0 * 2.0 - 1.0);
+    }
+}
