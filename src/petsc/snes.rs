@@ -42,16 +42,7 @@ pub struct Snes {
 struct Ctx<'a> {
     problem: &'a mut dyn NonlinearProblem,
     error: Option<String>,
-    /// Residual norm at each iteration, for the stall test.
-    norms: Vec<f64>,
-    stalled: bool,
 }
-
-/// Newton has stalled when its residual fell by less than [`STALL_FACTOR`] over this many
-/// iterations: a stuck backtracking line search creeps on for the rest of `max_it` (60
-/// iterations, half a minute on the T-bar) before a cut step that converges in ten.
-const STALL_WINDOW: usize = 25;
-const STALL_FACTOR: f64 = 0.5;
 
 const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
 /// Newton also stops when its update is this small relative to the solution: with a good
@@ -124,8 +115,6 @@ impl Snes {
         let mut ctx = Ctx {
             problem,
             error: None,
-            norms: Vec::new(),
-            stalled: false,
         };
         let ctx_ptr = &mut ctx as *mut Ctx as *mut c_void;
         // SAFETY: ctx outlives SNESSolve, the only place the callbacks run; the callbacks catch
@@ -138,10 +127,6 @@ impl Snes {
             check(
                 ffi::SNESSetJacobian(self.raw, jac.raw, jac.raw, Some(jacobian_cb), ctx_ptr),
                 "SNESSetJacobian",
-            )?;
-            check(
-                ffi::SNESSetConvergenceTest(self.raw, Some(converged_cb), ctx_ptr, None),
-                "SNESSetConvergenceTest",
             )?;
             check(
                 ffi::SNESSolve(self.raw, std::ptr::null_mut(), x.raw),
@@ -196,12 +181,6 @@ impl Snes {
                 return Err(PetscError {
                     code: DIVERGED,
                     message: format!("Newton stalled (update below {STEP_TOL:e} of the solution after a step damped to {lambda:.1e}) after {its} iterations, residual {norm:.3e}"),
-                });
-            }
-            if ctx.stalled {
-                return Err(PetscError {
-                    code: DIVERGED,
-                    message: format!("Newton stalled (the residual fell by less than {STALL_FACTOR} in {STALL_WINDOW} iterations) after {its} iterations, residual {norm:.3e}"),
                 });
             }
             if reason < 0 {
@@ -269,40 +248,6 @@ fn ctx_note(ctx: &mut Ctx, fatal: Option<()>, msg: &str) {
     if fatal.is_some() && ctx.error.is_none() {
         ctx.error = Some(msg.to_string());
     }
-}
-
-/// PETSc's default test, then the stall test. Plain arithmetic on the context: nothing here
-/// can panic across the C boundary.
-unsafe extern "C" fn converged_cb(
-    snes: ffi::SNES,
-    it: ffi::PetscInt,
-    xnorm: f64,
-    step: f64,
-    fnorm: f64,
-    reason: *mut ffi::SNESConvergedReason,
-    ctx: *mut c_void,
-) -> ffi::PetscErrorCode {
-    // SAFETY: PETSc passes the live SNES, its reason slot and the context set in `solve`.
-    let code = unsafe {
-        ffi::SNESConvergedDefault(snes, it, xnorm, step, fnorm, reason, std::ptr::null_mut())
-    };
-    if code != 0 {
-        return code;
-    }
-    // SAFETY: as above; `solve` holds the Ctx for the whole SNESSolve.
-    let (ctx, reason) = unsafe { (&mut *(ctx as *mut Ctx), &mut *reason) };
-    let it = it.max(0) as usize;
-    ctx.norms.truncate(it);
-    ctx.norms.push(fnorm);
-    if *reason == ffi::SNESConvergedReason_SNES_CONVERGED_ITERATING
-        && it >= STALL_WINDOW
-        && ctx.norms.len() == it + 1
-        && fnorm > STALL_FACTOR * ctx.norms[it - STALL_WINDOW]
-    {
-        ctx.stalled = true;
-        *reason = ffi::SNESConvergedReason_SNES_DIVERGED_LINE_SEARCH;
-    }
-    0
 }
 
 unsafe extern "C" fn residual_cb(
