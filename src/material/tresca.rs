@@ -105,11 +105,6 @@ impl Tresca {
         self.young / (3.0 * (1.0 - 2.0 * self.poisson))
     }
 
-    /// Elastic plane-strain stiffness (equal to [`super::elastic::LinearElastic::stiffness`]).
-    pub fn elastic_stiffness(&self) -> [[f64; 4]; 4] {
-        self.tangent(1.0, None)
-    }
-
     /// K m⊗m + 2G (P_dev − P_in) + 2Gβ (P_in − N⊗N), N⊗N omitted when `n` is `None`.
     fn tangent(&self, beta: f64, n: Option<&[f64; 4]>) -> [[f64; 4]; 4] {
         let k = self.bulk_modulus();

@@ -6,7 +6,6 @@
 use super::alpha::{alpha_keep, boundary_edges};
 use super::delaunay::delaunay;
 use super::near_ties::settle_near_ties;
-use std::collections::HashMap;
 
 /// Every kept triangle has circumradius R <= alpha*h and an owned vertex on its circumcircle, so its
 /// circumdisk lies within 2R of that vertex: every particle that could spoil the empty-circle test
@@ -137,15 +136,6 @@ impl LocalMesh {
     /// The triangle's global-id key (smallest gid first, CCW).
     pub fn tri_key(&self, t: usize) -> [u64; 3] {
         key(&self.tris[t], &self.gids)
-    }
-
-    /// Local index of each global id present on this rank.
-    pub fn index_of(&self) -> HashMap<u64, u32> {
-        self.gids
-            .iter()
-            .enumerate()
-            .map(|(i, &g)| (g, i as u32))
-            .collect()
     }
 
     /// Number of owned triangles (for balance and the fingerprint).

@@ -59,36 +59,6 @@ impl Petsc {
             _argv: argv,
         })
     }
-
-    /// Sets an option unless the user gave it on the command line: our defaults, user's last word.
-    pub fn default_option(&self, name: &str, value: &str) -> Result<(), PetscError> {
-        let cname = cstring(name)?;
-        let cvalue = cstring(value)?;
-        let mut set: ffi::PetscBool = 0;
-        // SAFETY: valid nul-terminated strings; null options database means the global one.
-        unsafe {
-            check(
-                ffi::PetscOptionsHasName(
-                    std::ptr::null_mut(),
-                    std::ptr::null(),
-                    cname.as_ptr(),
-                    &mut set,
-                ),
-                "PetscOptionsHasName",
-            )?;
-            if set == 0 {
-                check(
-                    ffi::PetscOptionsSetValue(
-                        std::ptr::null_mut(),
-                        cname.as_ptr(),
-                        cvalue.as_ptr(),
-                    ),
-                    "PetscOptionsSetValue",
-                )?;
-            }
-        }
-        Ok(())
-    }
 }
 
 impl Drop for Petsc {

@@ -123,26 +123,4 @@ impl VecRef {
         )?;
         Ok(n as usize)
     }
-
-    /// First global index owned by this rank.
-    pub fn ownership_start(&self) -> Result<usize, PetscError> {
-        let (mut lo, mut hi): (ffi::PetscInt, ffi::PetscInt) = (0, 0);
-        // SAFETY: live vector.
-        check(
-            unsafe { ffi::VecGetOwnershipRange(self.raw, &mut lo, &mut hi) },
-            "VecGetOwnershipRange",
-        )?;
-        Ok(lo as usize)
-    }
-
-    /// Collective. Euclidean norm over all ranks.
-    pub fn norm2(&self) -> Result<f64, PetscError> {
-        let mut v = 0.0;
-        // SAFETY: live vector.
-        check(
-            unsafe { ffi::VecNorm(self.raw, ffi::NormType_NORM_2, &mut v) },
-            "VecNorm",
-        )?;
-        Ok(v)
-    }
 }

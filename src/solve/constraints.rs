@@ -30,13 +30,4 @@ impl Constraints {
         }
         Constraints { fixed }
     }
-
-    pub fn count_owned(&self, dofs: &DofMap) -> usize {
-        self.fixed
-            .iter()
-            .zip(&dofs.node_owned)
-            .filter(|(_, &o)| o)
-            .map(|(f, _)| f.iter().filter(|c| c.is_some()).count())
-            .sum()
-    }
 }
