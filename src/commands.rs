@@ -17,6 +17,7 @@ pub fn execute(command: Command) -> i32 {
         return 1;
     };
     let world = universe.world();
+    pfem_partition::abort_job_on_panic();
     let local = match command {
         Command::New { scene, out, sets } => new(&world, &scene, &out, &sets),
         Command::Info { file } => {

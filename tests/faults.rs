@@ -279,3 +279,27 @@ fn a_point_load_on_no_particle_is_an_error() {
         ],
     );
 }
+
+#[test]
+fn a_damaged_scene_attribute_is_an_error_not_a_panic() {
+    let dir = workdir("faults-utf8");
+    small_cantilever(&dir, 2, &[]);
+    let path = dir.join("c.h5");
+    let mut bytes = std::fs::read(&path).unwrap();
+    let at = bytes
+        .windows(5)
+        .position(|w| w == b"young")
+        .expect("the scene's text is in the file");
+    bytes[at + 1] = 0xff;
+    std::fs::write(&path, &bytes).unwrap();
+    for args in [&["info", "c.h5"][..], &["c.h5", "--out", "o"][..]] {
+        let out = run(&dir, 1, args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} must fail");
+        assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+        assert!(
+            stderr.contains("scene") && stderr.contains("not valid UTF-8"),
+            "{args:?}: {stderr}"
+        );
+    }
+}

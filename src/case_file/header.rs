@@ -99,19 +99,35 @@ impl Reader<'_> {
         }
         let read_err = |e: hdf5::Error| self.err(name, format!("cannot read: {e}"));
         let text = match desc {
+            // The bytes are checked here: the HDF5 string types trust the file, and a flipped
+            // byte would reach the TOML parser as a `str` that is not UTF-8.
             TypeDescriptor::VarLenUnicode => attr
                 .read_raw::<VarLenUnicode>()
                 .map_err(read_err)?
                 .first()
-                .map(|s| s.as_str().to_string()),
+                .map(|s| self.utf8(name, s.as_bytes()))
+                .transpose()?,
             TypeDescriptor::VarLenAscii => attr
                 .read_raw::<VarLenAscii>()
                 .map_err(read_err)?
                 .first()
-                .map(|s| s.as_str().to_string()),
+                .map(|s| self.utf8(name, s.as_bytes()))
+                .transpose()?,
             other => return Err(self.err(name, format!("expected a string, found {other}"))),
         };
         text.ok_or_else(|| self.err(name, "has no value".to_string()))
+    }
+
+    fn utf8(&self, name: &str, bytes: &[u8]) -> Result<String, CaseError> {
+        std::str::from_utf8(bytes).map(str::to_string).map_err(|e| {
+            self.err(
+                name,
+                format!(
+                    "is not valid UTF-8 (at byte {}): the file is damaged",
+                    e.valid_up_to()
+                ),
+            )
+        })
     }
 
     fn u64_array(&self, name: &str) -> Result<Vec<u64>, CaseError> {

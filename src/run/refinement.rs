@@ -120,15 +120,14 @@ impl Simulation {
             let (mut x, mut u) = (mid(mesh.points[a], mesh.points[b]), mid(disp(a), disp(b)));
             // A boundary chord round a body's corner cuts into the body: its new particle goes
             // onto the body's surface, where the soil it stands for is, instead of starting
-            // inside and held there by the contact's start offset.
-            if mesh.on_boundary[a] && mesh.on_boundary[b] {
-                for shape in &bodies {
-                    let prox = shape.closest(x);
-                    if prox.distance < 0.0 {
-                        for k in 0..2 {
-                            x[k] -= prox.distance * prox.normal[k];
-                            u[k] -= prox.distance * prox.normal[k];
-                        }
+            // inside and held there by the contact's start offset. (Only positions decide, so
+            // that every rank decides alike whether an end is a ghost or not.)
+            for shape in &bodies {
+                let prox = shape.closest(x);
+                if prox.distance < 0.0 {
+                    for k in 0..2 {
+                        x[k] -= prox.distance * prox.normal[k];
+                        u[k] -= prox.distance * prox.normal[k];
                     }
                 }
             }
