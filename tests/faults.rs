@@ -242,20 +242,7 @@ fn a_run_that_lost_its_body_is_an_error_not_done() {
 #[test]
 fn a_point_load_on_no_particle_is_an_error() {
     let dir = workdir("faults-lost-load");
-    ok(
-        &dir,
-        1,
-        &[
-            "new",
-            "cantilever",
-            "-o",
-            "c.h5",
-            "--set",
-            "mesh.h=0.5",
-            "--set",
-            "steps.count=2",
-        ],
-    );
+    small_cantilever(&dir, 2, &["mesh.h=0.5"]);
     // The tracked particle renamed to an id no particle has: the load was dropped silently.
     let edit = "import h5py, sys\nf = h5py.File(sys.argv[1], 'r+')\n\
                 f.attrs.modify('tracked_gids', [10**6])\nf.close()\n";
