@@ -317,6 +317,18 @@ fn truncate_utf8(mut s: String, max: usize) -> String {
     s
 }
 
+/// Makes a panic on one rank end every rank: after the default report, the panicking rank
+/// aborts the MPI job (the others would otherwise wait in their next collective for ever).
+/// Call once, after MPI is initialised.
+pub fn abort_job_on_panic() {
+    let report = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        report(info);
+        eprintln!("pfem-mpi: internal error (a panic, above): aborting every rank");
+        mpi::topology::SimpleCommunicator::world().abort(70);
+    }));
+}
+
 #[cfg(test)]
 mod tests {
     use super::truncate_utf8;
@@ -328,16 +340,4 @@ mod tests {
         // 'é' is two bytes: cutting in its middle must back off to the boundary.
         assert_eq!(truncate_utf8("aé".into(), 2), "a");
     }
-}
-
-/// Makes a panic on one rank end every rank: after the default report, the panicking rank
-/// aborts the MPI job (the others would otherwise wait in their next collective for ever).
-/// Call once, after MPI is initialised.
-pub fn abort_job_on_panic() {
-    let report = std::panic::take_hook();
-    std::panic::set_hook(Box::new(move |info| {
-        report(info);
-        eprintln!("pfem-mpi: internal error (a panic, above): aborting every rank");
-        mpi::topology::SimpleCommunicator::world().abort(70);
-    }));
 }
