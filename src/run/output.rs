@@ -37,7 +37,12 @@ fn check_same_case(dir: &Path, sim: &Simulation) -> Result<(), String> {
     let name = path.display().to_string();
     match crate::scene::Scene::from_toml(&text, &name, &[]) {
         Ok(scene) if &scene == sim.scene() => Ok(()),
-        _ => Err(format!(
+        Err(e) => Err(format!(
+            "{}: its scene.toml cannot be read back ({e}), so it cannot be told apart from \
+             another case's output; give another --out folder, or remove this one",
+            dir.display()
+        )),
+        Ok(_) => Err(format!(
             "{}: holds the output of another case ({name} is not this case's scene); give \
              another --out folder, or remove this one to start over",
             dir.display()
