@@ -47,14 +47,21 @@ impl Plan {
     }
 }
 
-/// Plans refinement of `mesh`. `h[p]` is the spacing of local point p; `protected(p)` marks owned
-/// particles that must neither move nor vanish (tracked or constrained ones). Boundary particles
+/// Plans refinement of `mesh` (`h[p]` is the spacing of local point p). `protected(p)` marks
+/// owned particles that must neither move nor vanish (tracked or constrained ones), with one
+/// exception: `support_gap(p)` is the distance to the nearest rigid body of a local point (owned
+/// or ghost) held by a sliding support (constrained in one direction only: a symmetry plane),
+/// `None` for any other. Where a symmetry plane meets a body (the soil under a T-bar's tip), the
+/// stagnating flow drives the plane's particles into the body and would pile them up without
+/// bound, so such a particle within the merge distance of the body goes when a neighbour on the
+/// same support, nearer the body, is closer than the merge distance. Other boundary particles
 /// never move and vanish only where `slides(p)`: on a rigid body's face, where the soil flows
 /// along the body and converging flow would otherwise pile particles up without bound.
 pub fn plan(
     mesh: &LocalMesh,
     protected: impl Fn(usize) -> bool,
     slides: impl Fn(usize) -> bool,
+    support_gap: impl Fn(usize) -> Option<f64>,
     params: &RefineParams,
 ) -> Plan {
     let n = mesh.n_owned;
@@ -111,10 +118,25 @@ pub fn plan(
     for (p, nb) in neighbours.iter_mut().enumerate() {
         nb.sort_unstable();
         nb.dedup();
-        if protected(p) || nb.is_empty() {
+        let pu = p as u32;
+        if nb.is_empty() {
             continue;
         }
-        let pu = p as u32;
+        if protected(p) {
+            if let (Some(gap), [a, c]) = (support_gap(p), &along[p][..]) {
+                let crowded = [*a, *c].iter().any(|&q| {
+                    support_gap(q as usize).is_some_and(|g| g < gap)
+                        && dist(pu, q) < params.merge_distance * spacing(pu, q)
+                });
+                if gap < params.merge_distance * h[p]
+                    && crowded
+                    && dist(*a, *c) < params.split_length * spacing(*a, *c)
+                {
+                    remove.push(pu);
+                }
+            }
+            continue;
+        }
         if mesh.on_boundary[p] {
             // Only a particle between exactly two boundary neighbours, close to the one with
             // the smaller id, and whose neighbours stay closer than the split length: the
@@ -197,7 +219,7 @@ mod tests {
     #[test]
     fn regular_lattice_needs_nothing() {
         let m = lattice(6, 5, 0.5, |_| [0.0, 0.0]);
-        let p = plan(&m, |_| false, |_| false, &RefineParams::default());
+        let p = plan(&m, |_| false, |_| false, |_| None, &RefineParams::default());
         assert!(p.is_empty(), "{p:?}");
     }
 
@@ -210,7 +232,7 @@ mod tests {
             1.0,
             |i| if i == 12 { [-0.7, 0.0] } else { [0.0, 0.0] },
         );
-        let p = plan(&m, |_| false, |_| false, &RefineParams::default());
+        let p = plan(&m, |_| false, |_| false, |_| None, &RefineParams::default());
         assert_eq!(p.remove, vec![12]);
         assert!(!p.split.is_empty(), "the gap left at x = 2 has long edges");
         for [a, b] in &p.split {
@@ -233,10 +255,10 @@ mod tests {
             ..Default::default()
         };
         let lattice = lattice(6, 5, 0.5, |_| [0.0, 0.0]);
-        assert!(plan(&lattice, |_| false, |_| false, &params).is_empty());
+        assert!(plan(&lattice, |_| false, |_| false, |_| None, &params).is_empty());
 
         let m = lattice_with(12, [0.58, 0.0]);
-        let p = plan(&m, |_| false, |_| false, &params);
+        let p = plan(&m, |_| false, |_| false, |_| None, &params);
         assert!(p.smooth.iter().all(|(i, _)| !m.on_boundary[*i as usize]));
         let (_, target) = p
             .smooth
@@ -251,7 +273,7 @@ mod tests {
             after > before,
             "smoothing must improve the worst angle: {before} -> {after}"
         );
-        let none = plan(&m, |i| i == 12, |_| false, &params);
+        let none = plan(&m, |i| i == 12, |_| false, |_| None, &params);
         assert!(none.smooth.iter().all(|(i, _)| *i != 12));
     }
 
@@ -265,12 +287,44 @@ mod tests {
         });
         assert!(m.on_boundary[2]);
         let params = RefineParams::default();
-        assert!(plan(&m, |_| false, |_| false, &params).remove.is_empty());
-        assert_eq!(plan(&m, |_| false, |_| true, &params).remove, vec![2]);
-        assert!(plan(&m, |i| i == 2, |_| true, &params).remove.is_empty());
+        assert!(plan(&m, |_| false, |_| false, |_| None, &params)
+            .remove
+            .is_empty());
+        assert_eq!(
+            plan(&m, |_| false, |_| true, |_| None, &params).remove,
+            vec![2]
+        );
+        assert!(plan(&m, |i| i == 2, |_| true, |_| None, &params)
+            .remove
+            .is_empty());
         // Without particle 3 closing in, removing 2 would leave an edge to split at once.
         let gap = lattice_with(2, [-0.7, 0.0]);
-        assert!(plan(&gap, |_| false, |_| true, &params).remove.is_empty());
+        assert!(plan(&gap, |_| false, |_| true, |_| None, &params)
+            .remove
+            .is_empty());
+    }
+
+    #[test]
+    fn a_symmetry_plane_sheds_particles_only_where_it_meets_a_body() {
+        // Left column x = 0 is a symmetry plane; a body's face is at y = 4 (particle 20 on it).
+        // The flow has carried 15 up to 0.3 below it, and 10 after it.
+        let m = lattice(5, 5, 1.0, |i| match i {
+            15 => [0.0, 0.7],
+            10 => [0.0, 0.5],
+            _ => [0.0, 0.0],
+        });
+        let on_plane = |p: usize| m.points[p][0] == 0.0;
+        let gap = |p: usize| on_plane(p).then(|| 4.0 - m.points[p][1]);
+        let params = RefineParams::default();
+        assert_eq!(plan(&m, on_plane, |_| false, gap, &params).remove, vec![15]);
+        // Held in both directions (no sliding support), or with no body near: it stays.
+        assert!(plan(&m, on_plane, |_| false, |_| None, &params)
+            .remove
+            .is_empty());
+        let far = |p: usize| on_plane(p).then(|| 10.0 - m.points[p][1]);
+        assert!(plan(&m, on_plane, |_| false, far, &params)
+            .remove
+            .is_empty());
     }
 
     fn lattice_with(moved: usize, by: [f64; 2]) -> LocalMesh {

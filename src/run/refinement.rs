@@ -47,7 +47,27 @@ impl Simulation {
                 .iter()
                 .any(|s| s.closest(mesh.points[p]).distance <= SLIDING_GAP * mesh.h[p])
         };
-        let mut plan = plan(mesh, protected, slides, &params);
+        // A particle held in one direction only (a symmetry plane) near a body: its distance
+        // to the body. Read for ghosts too, from their reference positions, as every rank
+        // holding the point has them bit for bit.
+        let support_gap = |p: usize| {
+            if bodies.is_empty() {
+                return None;
+            }
+            let bc = self.model.step_bc(
+                self.reference_position(mesh, p),
+                mesh.points[p],
+                lambda,
+                lambda,
+            );
+            (bc.iter().filter(|c| c.is_some()).count() == 1).then(|| {
+                bodies
+                    .iter()
+                    .map(|s| s.closest(mesh.points[p]).distance)
+                    .fold(f64::INFINITY, f64::min)
+            })
+        };
+        let mut plan = plan(mesh, protected, slides, support_gap, &params);
         if !settings.refine {
             plan.split.clear();
             plan.remove.clear();
