@@ -39,6 +39,8 @@ pub(crate) mod ffi;
 mod gauss;
 #[path = "case_file/header.rs"]
 mod header;
+#[path = "case_file/lockstep.rs"]
+mod lockstep;
 #[path = "case_file/particles.rs"]
 mod particles;
 #[path = "case_file/summary.rs"]
@@ -60,6 +62,7 @@ pub use particles::{ParticleSet, STATE_LEN};
 use crate::scene::{generate_particles, lattice, Scene};
 use collective::agree;
 use datasets::Column;
+pub(crate) use lockstep::{estimate as estimate_bytes, write_hdf5, Lockstep};
 
 /// Value of the `format` attribute.
 pub const FORMAT: &str = "pfem-mpi case";
@@ -222,9 +225,11 @@ fn read_column<T: H5Type>(
     ffi::read_collective(ds, &selected, out)
 }
 
+/// Collective. The whole file, one agreed step per attribute set and dataset.
 #[allow(clippy::too_many_arguments)]
 fn write_contents(
     file: &File,
+    step: &Lockstep<'_>,
     header: &CaseHeader,
     ranks: u32,
     local: &ParticleSet,
@@ -232,42 +237,61 @@ fn write_contents(
     n: usize,
     gauss: &GaussRecords,
     gauss_rows: (Range<usize>, usize),
-) -> hdf5::Result<()> {
-    header::write_header(file, header, ranks)?;
-    gauss::write(file, gauss, gauss_rows.0, gauss_rows.1)?;
-    let group = file.create_group(datasets::GROUP)?;
+) -> Result<(), CaseError> {
+    step.step("attributes", header::write_header(file, header, ranks))?;
+    gauss::write(file, step, gauss, gauss_rows.0, gauss_rows.1)?;
+    let group = step.step("group /particles", file.create_group(datasets::GROUP))?;
     let [gid, position, displacement, h, state, flags, increment] = datasets::columns();
-    write_column(&group, &gid, n, rows.clone(), &local.gid)?;
-    write_column(
-        &group,
+    let column =
+        |c: &Column, r: hdf5::Result<()>| step.step(&format!("dataset /particles/{}", c.name), r);
+    column(
+        &gid,
+        write_column(&group, &gid, n, rows.clone(), &local.gid),
+    )?;
+    column(
         &increment,
-        n,
-        rows.clone(),
-        local.increment.as_flattened(),
+        write_column(
+            &group,
+            &increment,
+            n,
+            rows.clone(),
+            local.increment.as_flattened(),
+        ),
     )?;
-    write_column(
-        &group,
+    column(
         &position,
-        n,
-        rows.clone(),
-        local.position.as_flattened(),
+        write_column(
+            &group,
+            &position,
+            n,
+            rows.clone(),
+            local.position.as_flattened(),
+        ),
     )?;
-    write_column(
-        &group,
+    column(
         &displacement,
-        n,
-        rows.clone(),
-        local.displacement.as_flattened(),
+        write_column(
+            &group,
+            &displacement,
+            n,
+            rows.clone(),
+            local.displacement.as_flattened(),
+        ),
     )?;
-    write_column(&group, &h, n, rows.clone(), &local.h)?;
-    write_column(&group, &state, n, rows.clone(), local.state.as_flattened())?;
-    write_column(&group, &flags, n, rows, &local.flags)
+    column(&h, write_column(&group, &h, n, rows.clone(), &local.h))?;
+    column(
+        &state,
+        write_column(&group, &state, n, rows.clone(), local.state.as_flattened()),
+    )?;
+    column(&flags, write_column(&group, &flags, n, rows, &local.flags))
 }
 
 /// Collective. Writes a case file: every rank passes its own particles (any count, zero
 /// included), which are stored in rank order. The file is written as `path.tmp` and renamed to
 /// `path` by rank 0 once every rank has closed it, so an interrupted write never leaves a
-/// partial file under the final name. On error every rank returns the same error.
+/// partial file under the final name. Its disk space is reserved first, so a full disk is an
+/// error before anything is written. On error every rank returns the same error, the temporary
+/// is removed, and a file already at `path` is left as it was.
 pub fn write_case(
     comm: &SimpleCommunicator,
     path: &Path,
@@ -323,54 +347,25 @@ pub fn write_checkpoint(
     let gstart = (ginclusive - gcount) as usize;
     let gauss_rows = (gstart..gstart + gauss.len(), gtotal as usize);
 
-    let tmp = tmp_path(path);
-    let created = mpio_file(comm, &tmp, true).map_err(|e| {
-        CaseError::new(
-            path,
-            CaseErrorKind::Io,
-            format!("cannot create {}: {e}", tmp.display()),
-        )
-    });
-    let file = agree(comm, path, created)?;
     let ranks = comm.size() as u32;
-    let written = write_contents(
-        &file,
-        &header,
-        ranks,
-        local,
-        rows,
-        total as usize,
-        gauss,
-        gauss_rows,
-    );
-    let closed = file.close();
-    let outcome = written.and(closed).map_err(|e| {
-        CaseError::new(
-            path,
-            CaseErrorKind::Io,
-            format!("cannot write {}: {e}", tmp.display()),
+    let raw = total * datasets::bytes_per_particle()
+        + gtotal * (8 * (3 + GAUSS_LEN + NODE_LEN + CONTACT_LEN)) as u64
+        + 8 * (header.tracked_gids.len() + header.rank_counts.len()) as u64;
+    let text =
+        (header.scene_toml.len() + header.scene_source.len() + header.code_version.len()) as u64;
+    lockstep::write_hdf5(comm, path, lockstep::estimate(raw, text), |file, step| {
+        write_contents(
+            file,
+            step,
+            &header,
+            ranks,
+            local,
+            rows,
+            total as usize,
+            gauss,
+            gauss_rows,
         )
-    });
-    if let Err(e) = agree(comm, path, outcome) {
-        if comm.rank() == 0 {
-            // Best effort: the write already failed, a leftover temporary is harmless.
-            let _ = std::fs::remove_file(&tmp);
-        }
-        return Err(e);
-    }
-
-    let renamed = if comm.rank() == 0 {
-        std::fs::rename(&tmp, path).map_err(|e| {
-            CaseError::new(
-                path,
-                CaseErrorKind::Io,
-                format!("cannot rename {} to it: {e}", tmp.display()),
-            )
-        })
-    } else {
-        Ok(())
-    };
-    agree(comm, path, renamed)
+    })
 }
 
 /// Collective. Refuses, on every rank, an output `path` that is not a regular file (or absent)
