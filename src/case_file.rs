@@ -45,6 +45,10 @@ mod lockstep;
 mod particles;
 #[path = "case_file/summary.rs"]
 mod summary;
+#[path = "case_file/validate.rs"]
+pub mod validate;
+#[path = "case_file/validate_blocks.rs"]
+mod validate_blocks;
 
 use std::io::{Read, Seek, SeekFrom};
 use std::ops::Range;
@@ -383,11 +387,10 @@ pub fn check_output(
     agree(comm, path, checked)
 }
 
-fn read_contents(
-    comm: &SimpleCommunicator,
-    file: &File,
-    path: &Path,
-) -> Result<(CaseHeader, ParticleSet), CaseError> {
+/// The header, this rank's block of particles, its first row and the particle count.
+type Block = (CaseHeader, ParticleSet, usize, u64);
+
+fn read_contents(comm: &SimpleCommunicator, file: &File, path: &Path) -> Result<Block, CaseError> {
     let header = agree(comm, path, header::read_header(file, path))?;
     let (ds, n) = agree(comm, path, datasets::open_all(file, path))?;
     let block = same_blocks(&header, n, comm)
@@ -441,7 +444,7 @@ fn read_contents(
         )
     });
     agree(comm, path, read)?;
-    Ok((header, p))
+    Ok((header, p, block.start as usize, n))
 }
 
 /// The block this rank wrote, when the file was written by as many ranks as read it.
@@ -455,12 +458,14 @@ fn same_blocks(header: &CaseHeader, n: u64, comm: &SimpleCommunicator) -> Option
     Some(start..start + counts[r])
 }
 
-/// Collective. [`read_case`] plus a block of the stored Gauss states (empty for a new case).
+/// Collective. [`read_case`] plus a block of the stored Gauss states (empty for a new case),
+/// with every rule of [`validate`] checked across all ranks: a case that breaks one is an error
+/// naming the dataset or attribute, the same on every rank.
 pub fn read_checkpoint(
     comm: &SimpleCommunicator,
     path: &Path,
 ) -> Result<(CaseHeader, ParticleSet, GaussRecords), CaseError> {
-    let (header, particles) = read_case(comm, path)?;
+    let (header, particles, first, n) = read_block(comm, path)?;
     let opened = mpio_file(comm, path, false).map_err(|e| open_error(path, e));
     let file = agree(comm, path, opened)?;
     let records = gauss::read(comm, &file, path);
@@ -468,17 +473,23 @@ pub fn read_checkpoint(
         .close()
         .map_err(|e| CaseError::new(path, CaseErrorKind::Io, format!("cannot close: {e}")));
     let records = agree(comm, path, records.and_then(|g| closed.map(|_| g)))?;
+    validate_blocks::validate_blocks(comm, path, &header, &particles, first, n, &records)?;
     Ok((header, particles, records))
 }
 
 /// Collective. Reads the header on every rank and a contiguous block of the particles on each
 /// (`block_range(n, size, rank)`); the file may have been written by any number of ranks. On
 /// error every rank returns the same error; a damaged or foreign file is an error, never a
-/// panic.
+/// panic. Checks the format (types, shapes, lengths), not the contents: [`read_checkpoint`]
+/// does both.
 pub fn read_case(
     comm: &SimpleCommunicator,
     path: &Path,
 ) -> Result<(CaseHeader, ParticleSet), CaseError> {
+    read_block(comm, path).map(|(h, p, _, _)| (h, p))
+}
+
+fn read_block(comm: &SimpleCommunicator, path: &Path) -> Result<Block, CaseError> {
     agree(comm, path, sniff(path))?;
     let opened = mpio_file(comm, path, false).map_err(|e| open_error(path, e));
     let file = agree(comm, path, opened)?;
@@ -491,30 +502,19 @@ pub fn read_case(
 }
 
 /// Human-readable summary of a case file (format, scene, progress, particles, extent), for
-/// `pfem-mpi info`. Reads the file serially; needs no communicator.
+/// `pfem-mpi info`. Reads and checks the whole file like a run on one rank does, so a file
+/// `info` accepts is one a run accepts. Needs MPI initialised (it reads on MPI_COMM_SELF).
 pub fn summarize(path: &Path) -> Result<String, CaseError> {
     sniff(path)?;
-    let file = File::open(path).map_err(|e| open_error(path, e))?;
-    let header = header::read_header(&file, path)?;
-    let (ds, n) = datasets::open_all(&file, path)?;
-    let read_err = |name: &str, e: hdf5::Error| {
-        CaseError::new(path, CaseErrorKind::Malformed, format!("cannot read: {e}"))
-            .at(format!("dataset /{}/{name}", datasets::GROUP))
-    };
-    let gid = ds[0].read_raw::<u64>().map_err(|e| read_err("gid", e))?;
-    let pairs = |d: &Dataset, name: &str| -> Result<Vec<[f64; 2]>, CaseError> {
-        let flat = d.read_raw::<f64>().map_err(|e| read_err(name, e))?;
-        Ok(flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
-    };
-    let position = pairs(&ds[1], "position")?;
-    let displacement = pairs(&ds[2], "displacement")?;
+    let comm = SimpleCommunicator::self_comm();
+    let (header, p, _) = read_checkpoint(&comm, path)?;
     Ok(summary::render(
         path,
         &header,
-        n,
-        &gid,
-        &position,
-        &displacement,
+        p.len() as u64,
+        &p.gid,
+        &p.position,
+        &p.displacement,
     ))
 }
 
