@@ -237,3 +237,99 @@ fn a_full_disk_ends_every_rank_with_one_message_and_leaves_whole_files() {
     assert_disk_full_error(&stderr, code, "disk-12k/x.h5");
     assert!(files_under(&disk).is_empty(), "nothing may be left");
 }
+
+/// (what, h5py edit of `f` with numpy as `np`, what the error must say). Each breaks one rule of
+/// a case file (`case_file/validate.rs`).
+const DAMAGE: &[(&str, &str, &[&str])] = &[
+    ("tracked id of no particle", "f.attrs.modify('tracked_gids', np.array([10**6], dtype=np.uint64))", &["attribute tracked_gids", "gid 1000000 names no particle"]),
+    ("no tracked id for the load", "del f.attrs['tracked_gids']; f.attrs.create('tracked_gids', np.zeros(0, dtype=np.uint64))", &["attribute tracked_gids", "holds 0 ids"]),
+    ("position far away", "f['particles/position'][5, 0] = 1e300", &["dataset /particles/position", "row 5", "times the scene's size"]),
+    ("position not finite", "f['particles/position'][3, 1] = np.inf", &["dataset /particles/position", "not finite"]),
+    ("NaN displacement", "f['particles/displacement'][2, 0] = np.nan", &["dataset /particles/displacement", "NaN"]),
+    ("inf increment", "f['particles/increment'][2, 1] = -np.inf", &["dataset /particles/increment", "-inf"]),
+    ("NaN state", "f['particles/state'][7, 4] = np.nan", &["dataset /particles/state", "row 7"]),
+    ("negative h", "f['particles/h'][4] = -0.5", &["dataset /particles/h", "not a positive number"]),
+    ("id at next_gid", "f['particles/gid'][1] = f.attrs['next_gid']", &["dataset /particles/gid", "not below next_gid"]),
+    ("duplicate id", "f['particles/gid'][1] = f['particles/gid'][0]", &["dataset /particles/gid", "given to two particles"]),
+    ("unknown flag bits", "f['particles/flags'][0] = 6", &["dataset /particles/flags", "unknown bits 0x6"]),
+    ("step beyond steps.count", "f.attrs.modify('step', np.uint64(99))", &["attribute step", "beyond the scene's steps.count = 5"]),
+    ("step reset on a deformed body", "f.attrs.modify('step', np.uint64(0))", &["attribute step", "particles are displaced"]),
+    ("load factor NaN", "f.attrs.modify('load_factor', np.nan)", &["attribute load_factor", "not finite"]),
+    ("dataset cut short", "n = f['particles/h'].shape[0]; d = f['particles/h'][:-1]; del f['particles/h']; f['particles/h'] = d", &["dataset /particles/h", "particles but /particles/gid has"]),
+    ("gauss key of no particle", "k = f['gauss/key']; k[0, 1] = 10**6", &["dataset /gauss/key", "vertex 1000000 is no particle"]),
+    ("gauss key clockwise", "k = f['gauss/key']; r = k[0]; k[0] = [r[0], r[2], r[1]]", &["dataset /gauss/key", "not counter-clockwise"]),
+    ("gauss key twice", "k = f['gauss/key']; k[1] = k[0]", &["dataset /gauss/key", "stored twice"]),
+    ("gauss key not smallest first", "k = f['gauss/key']; r = k[0]; k[0] = [r[1], r[2], r[0]]", &["dataset /gauss/key", "smallest first"]),
+    ("gauss state NaN", "f['gauss/state'][3, 5] = np.nan", &["dataset /gauss/state", "row 3"]),
+    ("scene changed to an invalid one", "s = f.attrs['scene']; del f.attrs['scene']; f.attrs['scene'] = s.replace('young', 'yung')", &["attribute scene", "yung"]),
+];
+
+#[test]
+fn damaged_case_files_are_errors_naming_the_dataset_in_info_and_runs() {
+    let dir = workdir("faults-damage");
+    ok(
+        &dir,
+        1,
+        &[
+            "new",
+            "cantilever",
+            "-o",
+            "c.h5",
+            "--set",
+            "mesh.h=0.5",
+            "--set",
+            "steps.count=5",
+        ],
+    );
+    ok(&dir, 2, &["c.h5", "--out", "r", "--until-step", "2"]);
+    let good = dir.join("r/checkpoints/step_000002.h5");
+    for (k, (what, edit, needles)) in DAMAGE.iter().enumerate() {
+        let name = format!("bad{k}.h5");
+        std::fs::copy(&good, dir.join(&name)).unwrap();
+        let script = format!(
+            "import h5py, sys, numpy as np\nf = h5py.File(sys.argv[1], 'r+')\n{edit}\nf.close()\n"
+        );
+        match Command::new("python3")
+            .args(["-c", &script, &name])
+            .current_dir(&dir)
+            .output()
+        {
+            Ok(o) if o.status.success() => {}
+            Ok(o) if String::from_utf8_lossy(&o.stderr).contains("No module named") => {
+                println!("skipped: python3 with h5py is needed to edit case files");
+                return;
+            }
+            other => panic!("{what}: the edit failed: {other:?}"),
+        }
+        // info on every file; a run on 2 ranks for every fifth (each run takes a second).
+        let mut how: Vec<(usize, Vec<&str>)> = vec![(1, vec!["info", &name])];
+        if k % 5 == 0 {
+            how.push((2, vec![&name, "--out", "o"]));
+        }
+        for (ranks, args) in how {
+            let (ok, code, stderr) = run_limited(&dir, ranks, &args);
+            assert!(!ok, "{what}: {args:?} on {ranks} rank(s) must fail");
+            assert_eq!(code, Some(1), "{what}: {stderr}");
+            assert!(!stderr.contains("panicked"), "{what}: {stderr}");
+            assert_eq!(
+                stderr.matches("pfem-mpi: error:").count(),
+                1,
+                "{what}: {stderr}"
+            );
+            assert!(
+                stderr.contains(&format!("{name}: ")),
+                "{what}: names the file: {stderr}"
+            );
+            for n in *needles {
+                assert!(stderr.contains(n), "{what}: should say {n:?}:\n{stderr}");
+            }
+        }
+    }
+    assert!(
+        !dir.join("o/checkpoints").exists()
+            || std::fs::read_dir(dir.join("o/checkpoints"))
+                .unwrap()
+                .count()
+                == 0
+    );
+}
