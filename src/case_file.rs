@@ -39,10 +39,16 @@ pub(crate) mod ffi;
 mod gauss;
 #[path = "case_file/header.rs"]
 mod header;
+#[path = "case_file/lockstep.rs"]
+mod lockstep;
 #[path = "case_file/particles.rs"]
 mod particles;
 #[path = "case_file/summary.rs"]
 mod summary;
+#[path = "case_file/validate.rs"]
+pub mod validate;
+#[path = "case_file/validate_blocks.rs"]
+mod validate_blocks;
 
 use std::io::{Read, Seek, SeekFrom};
 use std::ops::Range;
@@ -60,6 +66,7 @@ pub use particles::{ParticleSet, STATE_LEN};
 use crate::scene::{generate_particles, lattice, Scene};
 use collective::agree;
 use datasets::Column;
+pub(crate) use lockstep::{estimate as estimate_bytes, write_hdf5, Lockstep};
 
 /// Value of the `format` attribute.
 pub const FORMAT: &str = "pfem-mpi case";
@@ -222,9 +229,11 @@ fn read_column<T: H5Type>(
     ffi::read_collective(ds, &selected, out)
 }
 
+/// Collective. The whole file, one agreed step per attribute set and dataset.
 #[allow(clippy::too_many_arguments)]
 fn write_contents(
     file: &File,
+    step: &Lockstep<'_>,
     header: &CaseHeader,
     ranks: u32,
     local: &ParticleSet,
@@ -232,42 +241,61 @@ fn write_contents(
     n: usize,
     gauss: &GaussRecords,
     gauss_rows: (Range<usize>, usize),
-) -> hdf5::Result<()> {
-    header::write_header(file, header, ranks)?;
-    gauss::write(file, gauss, gauss_rows.0, gauss_rows.1)?;
-    let group = file.create_group(datasets::GROUP)?;
+) -> Result<(), CaseError> {
+    step.step("attributes", header::write_header(file, header, ranks))?;
+    gauss::write(file, step, gauss, gauss_rows.0, gauss_rows.1)?;
+    let group = step.step("group /particles", file.create_group(datasets::GROUP))?;
     let [gid, position, displacement, h, state, flags, increment] = datasets::columns();
-    write_column(&group, &gid, n, rows.clone(), &local.gid)?;
-    write_column(
-        &group,
+    let column =
+        |c: &Column, r: hdf5::Result<()>| step.step(&format!("dataset /particles/{}", c.name), r);
+    column(
+        &gid,
+        write_column(&group, &gid, n, rows.clone(), &local.gid),
+    )?;
+    column(
         &increment,
-        n,
-        rows.clone(),
-        local.increment.as_flattened(),
+        write_column(
+            &group,
+            &increment,
+            n,
+            rows.clone(),
+            local.increment.as_flattened(),
+        ),
     )?;
-    write_column(
-        &group,
+    column(
         &position,
-        n,
-        rows.clone(),
-        local.position.as_flattened(),
+        write_column(
+            &group,
+            &position,
+            n,
+            rows.clone(),
+            local.position.as_flattened(),
+        ),
     )?;
-    write_column(
-        &group,
+    column(
         &displacement,
-        n,
-        rows.clone(),
-        local.displacement.as_flattened(),
+        write_column(
+            &group,
+            &displacement,
+            n,
+            rows.clone(),
+            local.displacement.as_flattened(),
+        ),
     )?;
-    write_column(&group, &h, n, rows.clone(), &local.h)?;
-    write_column(&group, &state, n, rows.clone(), local.state.as_flattened())?;
-    write_column(&group, &flags, n, rows, &local.flags)
+    column(&h, write_column(&group, &h, n, rows.clone(), &local.h))?;
+    column(
+        &state,
+        write_column(&group, &state, n, rows.clone(), local.state.as_flattened()),
+    )?;
+    column(&flags, write_column(&group, &flags, n, rows, &local.flags))
 }
 
 /// Collective. Writes a case file: every rank passes its own particles (any count, zero
 /// included), which are stored in rank order. The file is written as `path.tmp` and renamed to
 /// `path` by rank 0 once every rank has closed it, so an interrupted write never leaves a
-/// partial file under the final name. On error every rank returns the same error.
+/// partial file under the final name. Its disk space is reserved first, so a full disk is an
+/// error before anything is written. On error every rank returns the same error, the temporary
+/// is removed, and a file already at `path` is left as it was.
 pub fn write_case(
     comm: &SimpleCommunicator,
     path: &Path,
@@ -323,54 +351,25 @@ pub fn write_checkpoint(
     let gstart = (ginclusive - gcount) as usize;
     let gauss_rows = (gstart..gstart + gauss.len(), gtotal as usize);
 
-    let tmp = tmp_path(path);
-    let created = mpio_file(comm, &tmp, true).map_err(|e| {
-        CaseError::new(
-            path,
-            CaseErrorKind::Io,
-            format!("cannot create {}: {e}", tmp.display()),
-        )
-    });
-    let file = agree(comm, path, created)?;
     let ranks = comm.size() as u32;
-    let written = write_contents(
-        &file,
-        &header,
-        ranks,
-        local,
-        rows,
-        total as usize,
-        gauss,
-        gauss_rows,
-    );
-    let closed = file.close();
-    let outcome = written.and(closed).map_err(|e| {
-        CaseError::new(
-            path,
-            CaseErrorKind::Io,
-            format!("cannot write {}: {e}", tmp.display()),
+    let raw = total * datasets::bytes_per_particle()
+        + gtotal * (8 * (3 + GAUSS_LEN + NODE_LEN + CONTACT_LEN)) as u64
+        + 8 * (header.tracked_gids.len() + header.rank_counts.len()) as u64;
+    let text =
+        (header.scene_toml.len() + header.scene_source.len() + header.code_version.len()) as u64;
+    lockstep::write_hdf5(comm, path, lockstep::estimate(raw, text), |file, step| {
+        write_contents(
+            file,
+            step,
+            &header,
+            ranks,
+            local,
+            rows,
+            total as usize,
+            gauss,
+            gauss_rows,
         )
-    });
-    if let Err(e) = agree(comm, path, outcome) {
-        if comm.rank() == 0 {
-            // Best effort: the write already failed, a leftover temporary is harmless.
-            let _ = std::fs::remove_file(&tmp);
-        }
-        return Err(e);
-    }
-
-    let renamed = if comm.rank() == 0 {
-        std::fs::rename(&tmp, path).map_err(|e| {
-            CaseError::new(
-                path,
-                CaseErrorKind::Io,
-                format!("cannot rename {} to it: {e}", tmp.display()),
-            )
-        })
-    } else {
-        Ok(())
-    };
-    agree(comm, path, renamed)
+    })
 }
 
 /// Collective. Refuses, on every rank, an output `path` that is not a regular file (or absent)
@@ -388,11 +387,10 @@ pub fn check_output(
     agree(comm, path, checked)
 }
 
-fn read_contents(
-    comm: &SimpleCommunicator,
-    file: &File,
-    path: &Path,
-) -> Result<(CaseHeader, ParticleSet), CaseError> {
+/// The header, this rank's block of particles, its first row and the particle count.
+type Block = (CaseHeader, ParticleSet, usize, u64);
+
+fn read_contents(comm: &SimpleCommunicator, file: &File, path: &Path) -> Result<Block, CaseError> {
     let header = agree(comm, path, header::read_header(file, path))?;
     let (ds, n) = agree(comm, path, datasets::open_all(file, path))?;
     let block = same_blocks(&header, n, comm)
@@ -446,7 +444,7 @@ fn read_contents(
         )
     });
     agree(comm, path, read)?;
-    Ok((header, p))
+    Ok((header, p, block.start as usize, n))
 }
 
 /// The block this rank wrote, when the file was written by as many ranks as read it.
@@ -460,12 +458,14 @@ fn same_blocks(header: &CaseHeader, n: u64, comm: &SimpleCommunicator) -> Option
     Some(start..start + counts[r])
 }
 
-/// Collective. [`read_case`] plus a block of the stored Gauss states (empty for a new case).
+/// Collective. [`read_case`] plus a block of the stored Gauss states (empty for a new case),
+/// with every rule of [`validate`] checked across all ranks: a case that breaks one is an error
+/// naming the dataset or attribute, the same on every rank.
 pub fn read_checkpoint(
     comm: &SimpleCommunicator,
     path: &Path,
 ) -> Result<(CaseHeader, ParticleSet, GaussRecords), CaseError> {
-    let (header, particles) = read_case(comm, path)?;
+    let (header, particles, first, n) = read_block(comm, path)?;
     let opened = mpio_file(comm, path, false).map_err(|e| open_error(path, e));
     let file = agree(comm, path, opened)?;
     let records = gauss::read(comm, &file, path);
@@ -473,17 +473,23 @@ pub fn read_checkpoint(
         .close()
         .map_err(|e| CaseError::new(path, CaseErrorKind::Io, format!("cannot close: {e}")));
     let records = agree(comm, path, records.and_then(|g| closed.map(|_| g)))?;
+    validate_blocks::validate_blocks(comm, path, &header, &particles, first, n, &records)?;
     Ok((header, particles, records))
 }
 
 /// Collective. Reads the header on every rank and a contiguous block of the particles on each
 /// (`block_range(n, size, rank)`); the file may have been written by any number of ranks. On
 /// error every rank returns the same error; a damaged or foreign file is an error, never a
-/// panic.
+/// panic. Checks the format (types, shapes, lengths), not the contents: [`read_checkpoint`]
+/// does both.
 pub fn read_case(
     comm: &SimpleCommunicator,
     path: &Path,
 ) -> Result<(CaseHeader, ParticleSet), CaseError> {
+    read_block(comm, path).map(|(h, p, _, _)| (h, p))
+}
+
+fn read_block(comm: &SimpleCommunicator, path: &Path) -> Result<Block, CaseError> {
     agree(comm, path, sniff(path))?;
     let opened = mpio_file(comm, path, false).map_err(|e| open_error(path, e));
     let file = agree(comm, path, opened)?;
@@ -496,30 +502,19 @@ pub fn read_case(
 }
 
 /// Human-readable summary of a case file (format, scene, progress, particles, extent), for
-/// `pfem-mpi info`. Reads the file serially; needs no communicator.
+/// `pfem-mpi info`. Reads and checks the whole file like a run on one rank does, so a file
+/// `info` accepts is one a run accepts. Needs MPI initialised (it reads on MPI_COMM_SELF).
 pub fn summarize(path: &Path) -> Result<String, CaseError> {
     sniff(path)?;
-    let file = File::open(path).map_err(|e| open_error(path, e))?;
-    let header = header::read_header(&file, path)?;
-    let (ds, n) = datasets::open_all(&file, path)?;
-    let read_err = |name: &str, e: hdf5::Error| {
-        CaseError::new(path, CaseErrorKind::Malformed, format!("cannot read: {e}"))
-            .at(format!("dataset /{}/{name}", datasets::GROUP))
-    };
-    let gid = ds[0].read_raw::<u64>().map_err(|e| read_err("gid", e))?;
-    let pairs = |d: &Dataset, name: &str| -> Result<Vec<[f64; 2]>, CaseError> {
-        let flat = d.read_raw::<f64>().map_err(|e| read_err(name, e))?;
-        Ok(flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
-    };
-    let position = pairs(&ds[1], "position")?;
-    let displacement = pairs(&ds[2], "displacement")?;
+    let comm = SimpleCommunicator::self_comm();
+    let (header, p, _) = read_checkpoint(&comm, path)?;
     Ok(summary::render(
         path,
         &header,
-        n,
-        &gid,
-        &position,
-        &displacement,
+        p.len() as u64,
+        &p.gid,
+        &p.position,
+        &p.displacement,
     ))
 }
 

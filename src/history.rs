@@ -2,7 +2,7 @@
 //! The column names are a public interface (README, "Output").
 
 use crate::scene::{HistoryKind, Measure, Scene};
-use std::fs::{self, File, OpenOptions};
+use std::fs::{File, OpenOptions};
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 
@@ -173,6 +173,8 @@ fn kind_row(scene: &Scene, kind: HistoryKind, m: &Measures) -> Result<Vec<f64>, 
 pub struct HistoryFile {
     file: File,
     pub path: PathBuf,
+    /// Bytes of whole rows in the file.
+    len: u64,
 }
 
 impl HistoryFile {
@@ -200,22 +202,44 @@ impl HistoryFile {
                 }
             }
         }
-        let tmp = path.with_extension("csv.tmp");
-        fs::write(&tmp, kept.join("\n") + "\n").map_err(|e| format!("{}: {e}", tmp.display()))?;
-        fs::rename(&tmp, &path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = kept.join("\n") + "\n";
+        crate::output::replace_file(&path, text.as_bytes())
+            .map_err(|m| format!("{}: {m}", path.display()))?;
         let file = OpenOptions::new()
             .append(true)
             .open(&path)
             .map_err(|e| format!("{}: {e}", path.display()))?;
-        Ok(HistoryFile { file, path })
+        Ok(HistoryFile {
+            file,
+            path,
+            len: text.len() as u64,
+        })
     }
 
+    /// Appends the row of `step`. A row that cannot be written whole is cut off again, so the
+    /// file never ends in a partial row.
     pub fn append(&mut self, step: u64, values: &[f64]) -> Result<(), String> {
         let mut line = step.to_string();
         for v in values {
             // Shortest representation that reads back to the same f64: runs compare bit for bit.
             line.push_str(&format!(",{v:e}"));
         }
-        writeln!(self.file, "{line}").map_err(|e| format!("{}: {e}", self.path.display()))
+        line.push('\n');
+        match self.file.write_all(line.as_bytes()) {
+            Ok(()) => {
+                self.len += line.len() as u64;
+                Ok(())
+            }
+            Err(e) => {
+                let cut = match self.file.set_len(self.len) {
+                    Ok(()) => String::new(),
+                    Err(c) => format!(" (and the partial row could not be cut off: {c})"),
+                };
+                Err(format!(
+                    "{}: cannot append the row of step {step}: {e}{cut}",
+                    self.path.display()
+                ))
+            }
+        }
     }
 }

@@ -260,10 +260,8 @@ fn a_point_load_on_no_particle_is_an_error() {
     refused(
         &dir,
         &["c.h5"],
-        &[
-            "step 1: point_load[0] at [10, 0.5] does not reach the body",
-            "gid 1000000",
-        ],
+        // Caught on reading now (issue 11 finding 4), before any step.
+        &["attribute tracked_gids", "gid 1000000 names no particle"],
     );
 }
 

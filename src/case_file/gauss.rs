@@ -13,6 +13,7 @@ use mpi::traits::*;
 use super::collective::block_range;
 use super::error::{CaseError, CaseErrorKind};
 use super::ffi;
+use super::lockstep::Lockstep;
 
 /// Values per triangle: 3 Gauss points x 9 state values.
 pub const GAUSS_LEN: usize = 27;
@@ -62,26 +63,45 @@ fn column<T: H5Type>(
     ffi::write_collective(&ds, &selected, data)
 }
 
-/// Collective: every rank writes its rows `rows` of `n`.
-pub fn write(file: &File, g: &GaussRecords, rows: Range<usize>, n: usize) -> hdf5::Result<()> {
-    column(file, "key", 3, n, rows.clone(), g.key.as_flattened())?;
-    column(
-        file,
+/// Collective: every rank writes its rows `rows` of `n`, one agreed step per dataset.
+pub(crate) fn write(
+    file: &File,
+    step: &Lockstep<'_>,
+    g: &GaussRecords,
+    rows: Range<usize>,
+    n: usize,
+) -> Result<(), CaseError> {
+    let each = |name: &str, r: hdf5::Result<()>| step.step(&format!("dataset /{GROUP}/{name}"), r);
+    each(
+        "key",
+        column(file, "key", 3, n, rows.clone(), g.key.as_flattened()),
+    )?;
+    each(
         "nodes",
-        NODE_LEN,
-        n,
-        rows.clone(),
-        g.nodes.as_flattened(),
+        column(
+            file,
+            "nodes",
+            NODE_LEN,
+            n,
+            rows.clone(),
+            g.nodes.as_flattened(),
+        ),
     )?;
-    column(
-        file,
+    each(
         "contact",
-        CONTACT_LEN,
-        n,
-        rows.clone(),
-        g.contact.as_flattened(),
+        column(
+            file,
+            "contact",
+            CONTACT_LEN,
+            n,
+            rows.clone(),
+            g.contact.as_flattened(),
+        ),
     )?;
-    column(file, "state", GAUSS_LEN, n, rows, g.state.as_flattened())
+    each(
+        "state",
+        column(file, "state", GAUSS_LEN, n, rows, g.state.as_flattened()),
+    )
 }
 
 /// Collective: a contiguous block of the records per rank (all empty when the group is absent).

@@ -8,10 +8,10 @@ use hdf5::{File, Group, H5Type};
 use mpi::traits::Communicator;
 use pfem_partition::Comm;
 
-use super::error::{agree, OutputError};
+use super::error::OutputError;
 use super::field::Field;
 use crate::case_file::ffi::write_collective;
-use crate::case_file::mpio_file;
+use crate::case_file::{estimate_bytes, write_hdf5, CaseError, Lockstep};
 
 /// Value of the root attribute `format`.
 pub(crate) const FORMAT: &str = "pfem-mpi fields";
@@ -68,44 +68,76 @@ fn put<T: H5Type>(file: &File, name: &str, value: T) -> hdf5::Result<()> {
     file.new_attr::<T>().create(name)?.write_scalar(&value)
 }
 
-fn write_contents(file: &File, ranks: u32, c: &Contents<'_>) -> hdf5::Result<()> {
-    let format: VarLenUnicode = FORMAT
+/// Collective. The whole frame, one agreed step per attribute and dataset.
+fn write_contents(
+    file: &File,
+    step: &Lockstep<'_>,
+    ranks: u32,
+    c: &Contents<'_>,
+) -> Result<(), CaseError> {
+    let format: hdf5::Result<VarLenUnicode> = FORMAT
         .parse()
-        .map_err(|e| hdf5::Error::Internal(format!("attribute format: {e}")))?;
-    file.new_attr::<VarLenUnicode>()
-        .create("format")?
-        .write_scalar(&format)?;
-    put(file, "format_version", FORMAT_VERSION)?;
-    put(file, "step", c.step)?;
-    put(file, "time", c.time)?;
-    put(file, "ranks", ranks)?;
-    write_rows(file, "geometry", 2, c.points, c.position.as_flattened())?;
-    write_rows(file, "connectivity", 3, c.triangles, c.connectivity)?;
-    write_rows(file, "gid", 1, c.points, c.gid)?;
-    let group = file.create_group(POINT_DATA)?;
+        .map_err(|e| hdf5::Error::Internal(format!("attribute format: {e}")));
+    step.step(
+        "attributes",
+        format.and_then(|format| {
+            file.new_attr::<VarLenUnicode>()
+                .create("format")?
+                .write_scalar(&format)?;
+            put(file, "format_version", FORMAT_VERSION)?;
+            put(file, "step", c.step)?;
+            put(file, "time", c.time)?;
+            put(file, "ranks", ranks)
+        }),
+    )?;
+    let geometry = c.position.as_flattened();
+    step.step(
+        "dataset /geometry",
+        write_rows(file, "geometry", 2, c.points, geometry),
+    )?;
+    step.step(
+        "dataset /connectivity",
+        write_rows(file, "connectivity", 3, c.triangles, c.connectivity),
+    )?;
+    step.step("dataset /gid", write_rows(file, "gid", 1, c.points, c.gid))?;
+    let group = step.step(
+        &format!("group /{POINT_DATA}"),
+        file.create_group(POINT_DATA),
+    )?;
     for f in c.fields {
-        write_rows(
-            &group,
-            f.name(),
-            f.kind().components(),
-            c.points,
-            &f.stored(),
+        step.step(
+            &format!("dataset /{POINT_DATA}/{}", f.name()),
+            write_rows(
+                &group,
+                f.name(),
+                f.kind().components(),
+                c.points,
+                &f.stored(),
+            ),
         )?;
     }
     Ok(())
 }
 
-/// Collective. Writes the frame file `path` (replacing any file of that name). Every rank
+/// Collective. Writes the frame file `path` through `path.tmp` and a rename (replacing any file
+/// of that name only once the new one is complete), its disk space reserved first. Every rank
 /// returns the same result.
 pub(crate) fn write(comm: &Comm, path: &Path, c: &Contents<'_>) -> Result<(), OutputError> {
-    let created = mpio_file(comm, path, true)
-        .map_err(|e| OutputError::new(path, format!("cannot create: {e}")));
-    let file = agree(comm, created)?;
     let ranks = u32::try_from(comm.size()).unwrap_or(u32::MAX);
-    let written = write_contents(&file, ranks, c);
-    let closed = file.close();
-    let outcome = written
-        .and(closed)
-        .map_err(|e| OutputError::new(path, format!("cannot write: {e}")));
-    agree(comm, outcome)
+    let per_point: usize = 3 + c
+        .fields
+        .iter()
+        .map(|f| f.kind().components())
+        .sum::<usize>();
+    let raw = 8 * (c.points.total * per_point + 3 * c.triangles.total) as u64;
+    write_hdf5(comm, path, estimate_bytes(raw, 64), |file, step| {
+        write_contents(file, step, ranks, c)
+    })
+    .map_err(|e| {
+        let message = match &e.location {
+            Some(at) => format!("{at}: {}", e.message),
+            None => e.message,
+        };
+        OutputError::new(path, message)
+    })
 }

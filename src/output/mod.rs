@@ -37,9 +37,9 @@ mod connectivity;
 mod error;
 mod field;
 mod frame_file;
+mod replace;
 mod xdmf;
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use mpi::traits::Communicator;
@@ -47,6 +47,7 @@ use pfem_partition::{allgather_u64, exscan_u64, Comm};
 
 pub use error::OutputError;
 pub use field::Field;
+pub use replace::replace_file;
 
 use error::agree;
 use field::{check_fields, signature, FieldDesc};
@@ -80,24 +81,10 @@ pub struct FieldsWriter {
     frames: Vec<FrameEntry>,
 }
 
-/// Writes `text` to `path` through `path.tmp` and a rename, so that `path` is always either
-/// the old or the new file.
-fn replace_file(path: &Path, text: &str) -> Result<(), OutputError> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    let written = std::fs::File::create(&tmp)
-        .and_then(|mut f| f.write_all(text.as_bytes()).and_then(|_| f.sync_all()));
-    if let Err(e) = written {
-        // Best effort: the write already failed, a leftover temporary is harmless.
-        let _ = std::fs::remove_file(&tmp);
-        return Err(OutputError::new(
-            path,
-            format!("cannot write {}: {e}", tmp.display()),
-        ));
-    }
-    std::fs::rename(&tmp, path)
-        .map_err(|e| OutputError::new(path, format!("cannot rename {} to it: {e}", tmp.display())))
+/// Writes the series `text` to `path` through `path.tmp` and a rename, so that `path` is
+/// always either the old or the new file.
+fn replace_series(path: &Path, text: &str) -> Result<(), OutputError> {
+    replace_file(path, text.as_bytes()).map_err(|m| OutputError::new(path, m))
 }
 
 /// The frames of the existing series at `path` up to `last_step`; none when there is no file.
@@ -167,7 +154,7 @@ impl FieldsWriter {
                     if first_step > 0 {
                         frames = kept_frames(&series_path, first_step)?;
                     }
-                    replace_file(&series_path, &series(&frames))
+                    replace_series(&series_path, &series(&frames))
                 })
         } else {
             Ok(())
@@ -248,7 +235,7 @@ impl FieldsWriter {
                 triangles: m as usize,
                 fields: &descs,
             }));
-            replace_file(&self.series_path(), &series(&self.frames))
+            replace_series(&self.series_path(), &series(&self.frames))
         } else {
             Ok(())
         };
@@ -311,7 +298,7 @@ mod tests {
                 })
             })
             .collect();
-        replace_file(&path, &series(&entries)).unwrap();
+        replace_series(&path, &series(&entries)).unwrap();
         assert!(!dir.join("fields.xdmf.tmp").exists());
         let kept = kept_frames(&path, 3).unwrap();
         assert_eq!(kept, entries[..2].to_vec());

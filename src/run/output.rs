@@ -20,10 +20,8 @@ pub struct Output {
 /// columns' reference lines (written to a temporary name and renamed).
 fn write_scene(dir: &Path, sim: &Simulation) -> Result<(), String> {
     let path = dir.join("scene.toml");
-    let tmp = dir.join("scene.toml.tmp");
-    std::fs::write(&tmp, sim.scene().to_toml())
-        .and_then(|_| std::fs::rename(&tmp, &path))
-        .map_err(|e| format!("{}: {e}", path.display()))
+    crate::output::replace_file(&path, sim.scene().to_toml().as_bytes())
+        .map_err(|m| format!("{}: {m}", path.display()))
 }
 
 /// Refuses a folder that holds another case's run: its checkpoints, history and fields would be
