@@ -290,3 +290,66 @@ fn a_damaged_scene_attribute_is_an_error_not_a_panic() {
         );
     }
 }
+
+/// Runs the small cantilever on 2 ranks with `PFEM_INJECT_FAULT=spec`; returns (success,
+/// stderr, seconds), failing the test if the job is not over within 30 s.
+fn injected(dir: &Path, spec: &str) -> (bool, String, f64) {
+    let mut child = Command::new("mpirun")
+        .args(["-n", "2", "--oversubscribe", bin(), "c.h5", "--out"])
+        .arg(format!("out-{}", spec.replace(':', "-")))
+        .current_dir(dir)
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
+        .env("PFEM_INJECT_FAULT", spec)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("launch mpirun");
+    let start = Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().expect("wait") {
+            break s;
+        }
+        if start.elapsed() > Duration::from_secs(30) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("PFEM_INJECT_FAULT={spec}: the job hung (not over after 30 s)");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let mut stderr = String::new();
+    use std::io::Read;
+    let _ = child.stderr.take().unwrap().read_to_string(&mut stderr);
+    (status.success(), stderr, start.elapsed().as_secs_f64())
+}
+
+#[test]
+fn a_fault_on_one_rank_ends_the_job_with_its_message() {
+    let dir = workdir("inject");
+    small_cantilever(&dir, 2, &[]);
+    // An error on rank 1 alone, in collective phases (rank 0 waits in a reduction, a PETSc solve
+    // or an output write for it), and a panic.
+    for (spec, says) in [
+        (
+            "1:remesh:error",
+            "injected fault: remesh of step 1 on rank 1",
+        ),
+        ("1:solve:error", "injected fault: solve of step 1 on rank 1"),
+        (
+            "1:output:error:2",
+            "injected fault: output of step 2 on rank 1",
+        ),
+        ("1:solve:panic", "injected fault: solve of step 1 on rank 1"),
+    ] {
+        let (ok, stderr, seconds) = injected(&dir, spec);
+        assert!(!ok, "{spec}: the job should fail:\n{stderr}");
+        assert!(
+            stderr.contains(says),
+            "{spec}: stderr should say {says:?}:\n{stderr}"
+        );
+        assert!(seconds < 20.0, "{spec}: the job took {seconds:.1} s to end");
+        println!("{spec}: over in {seconds:.1} s");
+    }
+}

@@ -76,7 +76,10 @@ pub(super) fn inject(rank: i32, phase: &str, step: u64) -> Result<(), String> {
     if f.rank != rank || f.phase != phase || (f.step != step && phase != "load") {
         return Ok(());
     }
-    let message = format!("injected fault: {phase} of step {step} on rank {rank}");
+    let message = match phase {
+        "load" => format!("injected fault: load on rank {rank}"),
+        _ => format!("injected fault: {phase} of step {step} on rank {rank}"),
+    };
     if f.panic {
         panic!("{message}");
     }
