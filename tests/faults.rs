@@ -353,3 +353,63 @@ fn a_fault_on_one_rank_ends_the_job_with_its_message() {
         println!("{spec}: over in {seconds:.1} s");
     }
 }
+
+#[test]
+fn conflicting_or_singular_setups_are_errors_with_the_right_advice() {
+    let dir = workdir("setups");
+    let new = |sets: &[&str]| {
+        let mut args = vec!["new", "cantilever", "-o", "x.h5", "--set", "mesh.h=0.5"];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        args.iter().map(|s| s.to_string()).collect::<Vec<_>>()
+    };
+    let check = |sets: &[&str], needles: &[&str]| {
+        let args = new(sets);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        refused(&dir, &args, needles);
+        assert!(!dir.join("x.h5").exists(), "{sets:?} left a case file");
+    };
+    check(
+        &["prescribed=[{where=\"x <= 0\", dofs=[\"y\"], total=[0.0,0.1]}]"],
+        &[
+            "prescribed[0] (where = \"x <= 0\")",
+            "fixed[0] (where = \"x <= 0\")",
+            "both constrain y",
+        ],
+    );
+    check(
+        &["fixed[0].where=\"x >= 0\""],
+        &["point_load[0].force", "acts on constrained components only"],
+    );
+    check(
+        &["fixed=[]"],
+        &["not held against rigid-body motion", "nothing holds it"],
+    );
+    check(
+        &["body.rectangles=[{origin=[0.0,0.0],size=[10.0,1.0]},{origin=[3.0,3.0],size=[2.0,1.0]}]"],
+        &["body.rectangles[1]", "not held against rigid-body motion"],
+    );
+    check(&["fixed[0].where=\"x <= 0 and y <= 0\""], &["can rotate"]);
+    // Ill-posed systems that only Newton finds: the advice names the cause, not the step size.
+    for (sets, says) in [
+        ("material.poisson=0.49999999", "solver.element = \"p2p1\""),
+        ("material.young=1e-300", "material.young = 1e-300 Pa"),
+    ] {
+        let _ = std::fs::remove_file(dir.join("x.h5"));
+        let _ = std::fs::remove_dir_all(dir.join("x.out"));
+        let args = new(&[sets, "steps.count=1"]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        ok(&dir, 1, &args);
+        let (ok, stderr) = run_limited(&dir, &["x.h5"], Duration::from_secs(60));
+        assert!(!ok, "{sets}: should fail");
+        assert!(
+            stderr.contains(says),
+            "{sets}: should say {says:?}:\n{stderr}"
+        );
+        assert!(
+            !stderr.contains("a smaller step"),
+            "{sets}: wrong advice:\n{stderr}"
+        );
+    }
+}
