@@ -8,7 +8,7 @@ use crate::petsc::Petsc;
 use crate::run::{run, RunOptions, Simulation};
 use crate::scene::{load_scene, scene_file};
 use mpi::traits::Communicator;
-use pfem_partition::{agree_on_error, gather_to_root, sum_f64, Comm};
+use pfem_partition::{gather_to_root, sum_f64, Comm};
 
 /// Runs a command under MPI; returns the process exit code.
 pub fn execute(command: Command) -> i32 {
@@ -18,6 +18,9 @@ pub fn execute(command: Command) -> i32 {
     };
     let world = universe.world();
     pfem_partition::abort_job_on_panic();
+    // The end-of-command agreement has a communicator of its own: a rank that failed alone
+    // must not have its agreement matched with a collective the others are waiting in.
+    let errors = world.duplicate();
     let local = match command {
         Command::New { scene, out, sets } => new(&world, &scene, &out, &sets),
         Command::Info { file } => {
@@ -54,9 +57,9 @@ pub fn execute(command: Command) -> i32 {
         }
         Command::Help | Command::Version => Ok(()),
     };
-    match agree_on_error(&world, local.err()) {
-        None => 0,
-        Some(e) => {
+    match crate::run::agree_or_abort(&errors, local) {
+        Ok(()) => 0,
+        Err(e) => {
             if world.rank() == 0 {
                 eprintln!("pfem-mpi: error: {e}");
             }

@@ -67,6 +67,8 @@ mod validate;
 mod validate_fine;
 #[path = "scene/validate_rigid.rs"]
 pub mod validate_rigid;
+#[path = "scene/validate_supports.rs"]
+mod validate_supports;
 #[path = "scene/value_de.rs"]
 mod value_de;
 

@@ -288,3 +288,126 @@ fn a_damaged_scene_attribute_is_an_error_not_a_panic() {
         );
     }
 }
+
+/// Runs the small cantilever on 2 ranks with `PFEM_INJECT_FAULT=spec`; returns (success,
+/// stderr, seconds), failing the test if the job is not over within 30 s.
+fn injected(dir: &Path, spec: &str) -> (bool, String, f64) {
+    let mut child = Command::new("mpirun")
+        .args(["-n", "2", "--oversubscribe", bin(), "c.h5", "--out"])
+        .arg(format!("out-{}", spec.replace(':', "-")))
+        .current_dir(dir)
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
+        .env("PFEM_INJECT_FAULT", spec)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("launch mpirun");
+    let start = Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().expect("wait") {
+            break s;
+        }
+        if start.elapsed() > Duration::from_secs(30) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("PFEM_INJECT_FAULT={spec}: the job hung (not over after 30 s)");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let mut stderr = String::new();
+    use std::io::Read;
+    let _ = child.stderr.take().unwrap().read_to_string(&mut stderr);
+    (status.success(), stderr, start.elapsed().as_secs_f64())
+}
+
+#[test]
+fn a_fault_on_one_rank_ends_the_job_with_its_message() {
+    let dir = workdir("inject");
+    small_cantilever(&dir, 2, &[]);
+    // An error on rank 1 alone, in collective phases (rank 0 waits in a reduction, a PETSc solve
+    // or an output write for it), and a panic.
+    for (spec, says) in [
+        (
+            "1:remesh:error",
+            "injected fault: remesh of step 1 on rank 1",
+        ),
+        ("1:solve:error", "injected fault: solve of step 1 on rank 1"),
+        (
+            "1:output:error:2",
+            "injected fault: output of step 2 on rank 1",
+        ),
+        ("1:solve:panic", "injected fault: solve of step 1 on rank 1"),
+    ] {
+        let (ok, stderr, seconds) = injected(&dir, spec);
+        assert!(!ok, "{spec}: the job should fail:\n{stderr}");
+        assert!(
+            stderr.contains(says),
+            "{spec}: stderr should say {says:?}:\n{stderr}"
+        );
+        assert!(seconds < 20.0, "{spec}: the job took {seconds:.1} s to end");
+        println!("{spec}: over in {seconds:.1} s");
+    }
+}
+
+#[test]
+fn conflicting_or_singular_setups_are_errors_with_the_right_advice() {
+    let dir = workdir("setups");
+    let new = |sets: &[&str]| {
+        let mut args = vec!["new", "cantilever", "-o", "x.h5", "--set", "mesh.h=0.5"];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        args.iter().map(|s| s.to_string()).collect::<Vec<_>>()
+    };
+    let check = |sets: &[&str], needles: &[&str]| {
+        let args = new(sets);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        refused(&dir, &args, needles);
+        assert!(!dir.join("x.h5").exists(), "{sets:?} left a case file");
+    };
+    check(
+        &["prescribed=[{where=\"x <= 0\", dofs=[\"y\"], total=[0.0,0.1]}]"],
+        &[
+            "prescribed[0] (where = \"x <= 0\")",
+            "fixed[0] (where = \"x <= 0\")",
+            "both constrain y",
+        ],
+    );
+    check(
+        &["fixed[0].where=\"x >= 0\""],
+        &["point_load[0].force", "acts on constrained components only"],
+    );
+    check(
+        &["fixed=[]"],
+        &["not held against rigid-body motion", "nothing holds it"],
+    );
+    check(
+        &["body.rectangles=[{origin=[0.0,0.0],size=[10.0,1.0]},{origin=[3.0,3.0],size=[2.0,1.0]}]"],
+        &["body.rectangles[1]", "not held against rigid-body motion"],
+    );
+    check(&["fixed[0].where=\"x <= 0 and y <= 0\""], &["can rotate"]);
+    // Ill-posed systems that only Newton finds: the advice names the cause, not the step size.
+    for (sets, says) in [
+        ("material.poisson=0.49999999", "solver.element = \"p2p1\""),
+        ("material.young=1e-300", "material.young = 1e-300 Pa"),
+    ] {
+        let _ = std::fs::remove_file(dir.join("x.h5"));
+        let _ = std::fs::remove_dir_all(dir.join("x.out"));
+        let args = new(&[sets, "steps.count=1"]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        ok(&dir, 1, &args);
+        let (ok, stderr) = run_limited(&dir, &["x.h5"], Duration::from_secs(60));
+        assert!(!ok, "{sets}: should fail");
+        assert!(
+            stderr.contains(says),
+            "{sets}: should say {says:?}:\n{stderr}"
+        );
+        assert!(
+            !stderr.contains("a smaller step"),
+            "{sets}: wrong advice:\n{stderr}"
+        );
+    }
+}

@@ -264,10 +264,59 @@ pub fn agree_on_error(comm: &Comm, local: Option<String>) -> Option<String> {
 /// Collective. Like [`agree_on_error`], also naming the lowest failing rank.
 pub(crate) fn first_error(comm: &Comm, local: Option<String>) -> Option<(i32, String)> {
     let size = comm.size();
-    let rank = comm.rank();
-    let mine = if local.is_some() { rank } else { size };
+    let mine = if local.is_some() { comm.rank() } else { size };
     let mut first = size;
     comm.all_reduce_into(&mine, &mut first, SystemOperation::min());
+    broadcast_first(comm, first, local)
+}
+
+/// Collective on `comm`, which nothing else may use (a duplicate of the world made for this):
+/// [`agree_on_error`] for the end of a command, where one rank may return an error that the
+/// others know nothing of while they wait for it in another collective. A rank with an error
+/// waits at most `patience` for the others; when they do not come, `abandon` gets the message
+/// (to print it) and the whole job is aborted (MPI_Abort, exit code 1). Ranks without an error
+/// wait as long as it takes: either every rank arrives or a failed one aborts them all.
+pub fn agree_on_error_or_abort(
+    comm: &Comm,
+    local: Option<String>,
+    patience: std::time::Duration,
+    abandon: impl FnOnce(&str),
+) -> Option<String> {
+    let size = comm.size();
+    let mut first = size;
+    match &local {
+        None => comm.all_reduce_into(&size, &mut first, SystemOperation::min()),
+        Some(message) => {
+            let rank = comm.rank();
+            let start = std::time::Instant::now();
+            mpi::request::scope(|scope| {
+                let mut request = comm.immediate_all_reduce_into(
+                    scope,
+                    &rank,
+                    &mut first,
+                    SystemOperation::min(),
+                );
+                loop {
+                    match request.test() {
+                        Ok(_) => break,
+                        Err(pending) => request = pending,
+                    }
+                    if start.elapsed() > patience {
+                        abandon(message);
+                        comm.abort(1);
+                    }
+                    std::thread::sleep(std::time::Duration::from_millis(5));
+                }
+            });
+        }
+    }
+    broadcast_first(comm, first, local).map(|(_, message)| message)
+}
+
+/// Collective. The message of rank `first` (the lowest failing rank; `comm.size()` when none
+/// failed) to every rank.
+fn broadcast_first(comm: &Comm, first: i32, local: Option<String>) -> Option<(i32, String)> {
+    let (size, rank) = (comm.size(), comm.rank());
     if first >= size {
         return None;
     }

@@ -25,7 +25,10 @@ pub mod metis_part;
 pub mod migrate;
 pub mod reduce;
 
-pub use comm::{abort_job_on_panic, agree_on_error, alltoallv, exscan_u64, fetch, gather_to_root};
+pub use comm::{
+    abort_job_on_panic, agree_on_error, agree_on_error_or_abort, alltoallv, exscan_u64, fetch,
+    gather_to_root,
+};
 pub use error::PartitionError;
 pub use halo::Halo;
 pub use metis_part::{imbalance, partition_graph};

@@ -9,10 +9,12 @@ mod sanity;
 mod signals;
 mod simulation;
 mod step;
+mod test_hooks;
 
 pub use simulation::{Simulation, StepReport};
 
 use crate::petsc::Petsc;
+use mpi::traits::Communicator;
 use pfem_partition::Comm;
 use progress::{PhaseTimer, Progress};
 use std::path::PathBuf;
@@ -25,32 +27,87 @@ pub struct RunOptions {
     pub until_step: Option<u64>,
 }
 
+/// How long a rank with an error waits for the others before it takes them to be stuck in a
+/// collective it left, and aborts the job with its message.
+const ERROR_PATIENCE: std::time::Duration = std::time::Duration::from_secs(5);
+
+/// Collective on `errors`, a communicator nothing else uses (a duplicate of the world): every
+/// rank gets the lowest failing rank's error; a rank that failed alone while the others wait in
+/// another collective prints its error and aborts the job after [`ERROR_PATIENCE`].
+pub fn agree_or_abort(errors: &Comm, local: Result<(), String>) -> Result<(), String> {
+    let rank = errors.rank();
+    let abandon = |e: &str| {
+        eprintln!(
+            "pfem-mpi: error: {e} (on rank {rank} alone, while the other ranks wait elsewhere: \
+             aborting the job)"
+        )
+    };
+    match pfem_partition::agree_on_error_or_abort(errors, local.err(), ERROR_PATIENCE, abandon) {
+        None => Ok(()),
+        Some(e) => Err(e),
+    }
+}
+
 /// Collective. Runs the case to its last step (or `until_step`, or the step during which SIGTERM
 /// or SIGUSR1 arrived), ending with a checkpoint.
 pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), String> {
+    let errors = world.duplicate();
+    let mut held = None;
+    let outcome = drive(world, petsc, opts, &mut held);
+    // Agreed before the simulation is dropped: destroying its solver is collective, and a rank
+    // that failed alone would wait there for ever.
+    let agreed = agree_or_abort(&errors, outcome);
+    drop(held);
+    agreed
+}
+
+fn drive(
+    world: &Comm,
+    petsc: &Petsc,
+    opts: &RunOptions,
+    held: &mut Option<Simulation>,
+) -> Result<(), String> {
     let stop = signals::StopRequest::install()?;
-    let mut sim = Simulation::load(world, &opts.case)?;
-    sanity::check_until_step(opts, &sim)?;
-    let mut out = output::Output::open(world, &sim, &opts.out_dir)?;
+    let rank = world.rank();
+    let fault = |phase: &str, step: u64| test_hooks::inject(rank, phase, step);
+    fault("load", 0)?;
+    let sim = held.insert(Simulation::load(world, &opts.case)?);
+    sanity::check_until_step(opts, sim)?;
+    let mut out = output::Output::open(world, sim, &opts.out_dir)?;
     let mut progress = Progress::new(world, sim.total_steps());
     let mut last = opts.until_step.unwrap_or(u64::MAX).min(sim.total_steps());
     while sim.step() < last {
         let mut t = PhaseTimer::default();
-        let mut mesh = t.time("remesh", || sim.remesh(world))?;
+        let next = sim.step() + 1;
+        let mut mesh = t.time("remesh", || {
+            fault("remesh", next)?;
+            sim.remesh(world)
+        })?;
+        fault("map", next)?;
         let states = t.time("map", || sim.map(&mesh));
-        let report = t.time("solve", || sim.advance(world, petsc, &mut mesh, states))?;
-        sanity::check_step(world, &sim, &mesh, &report)?;
+        let report = t.time("solve", || {
+            fault("solve", next)?;
+            sim.advance(world, petsc, &mut mesh, states)
+        })?;
+        sanity::check_step(world, sim, &mesh, &report)?;
         if stop.requested(world) {
             last = sim.step();
         }
         t.time("output", || {
-            out.record(world, &sim)
-                .and_then(|_| out.fields_if_due(world, &sim, &mesh, last))
+            fault("output", next)?;
+            out.record(world, sim)
+                .and_then(|_| out.fields_if_due(world, sim, &mesh, last))
         })?;
-        t.time("checkpoint", || out.checkpoint_if_due(world, &sim, last))?;
-        t.time("balance", || sim.rebalance_if_needed(world))?;
-        progress.step(&sim, &report, &t);
+        t.time("checkpoint", || {
+            fault("checkpoint", next)?;
+            out.checkpoint_if_due(world, sim, last)
+        })?;
+        t.time("balance", || {
+            fault("balance", next)?;
+            sim.rebalance_if_needed(world)
+        })?;
+        progress.step(sim, &report, &t);
     }
-    progress.finish(&sim);
+    progress.finish(sim);
     out.plot(world)
 }

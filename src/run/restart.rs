@@ -41,6 +41,16 @@ impl Simulation {
             state: p.state.clone(),
             flags: p.flags.iter().map(|f| f & !flag::TRACKED).collect(),
         };
+        let records = self.gauss_records();
+        let mut header = self.header.clone();
+        header.code_version = env!("CARGO_PKG_VERSION").to_string();
+        write_checkpoint(world, path, &header, &set, &records).map_err(|e| e.to_string())
+    }
+
+    /// The Gauss states of the last mesh with its node values (the Newton predictor) and contact
+    /// state, each triangle once: from the owner of its smallest-gid vertex. Rank-local.
+    pub(super) fn gauss_records(&self) -> GaussRecords {
+        let p = &self.particles;
         let mut records = GaussRecords::default();
         let last = self.last_nodes.borrow();
         let touching = self.last_contact.borrow();
@@ -71,9 +81,7 @@ impl Simulation {
                 records.contact.push(contact);
             }
         }
-        let mut header = self.header.clone();
-        header.code_version = env!("CARGO_PKG_VERSION").to_string();
-        write_checkpoint(world, path, &header, &set, &records).map_err(|e| e.to_string())
+        records
     }
 
     /// Collective. Sends each stored triangle (Gauss states and node values) to the owners of its

@@ -125,6 +125,65 @@ pub(super) fn check_step(
     Ok(())
 }
 
+/// Poisson's ratio from which the displacement (P2) element locks: its volumetric stiffness
+/// grows as 1/(1 - 2 nu) and swamps the shear response, so Newton stalls at any step size.
+const LOCKING_POISSON: f64 = 0.499;
+
+/// A lower bound of the strain the scene's loads impose: point loads over the body's smaller
+/// dimension, surface pressures and the body's weight, each divided by Young's modulus.
+fn load_strain(scene: &Scene) -> f64 {
+    let rects = &scene.body.rectangles;
+    let extent = |c: usize| {
+        let lo = rects
+            .iter()
+            .map(|r| r.origin[c])
+            .fold(f64::INFINITY, f64::min);
+        let hi = rects
+            .iter()
+            .map(|r| r.origin[c] + r.size[c])
+            .fold(f64::NEG_INFINITY, f64::max);
+        hi - lo
+    };
+    let e = scene.material.young;
+    let point: f64 = scene
+        .point_load
+        .iter()
+        .map(|p| p.force[0].hypot(p.force[1]))
+        .sum::<f64>()
+        / extent(0).min(extent(1));
+    let surface = scene
+        .surface_pressure
+        .iter()
+        .map(|p| p.pressure.abs())
+        .fold(0.0, f64::max);
+    let weight = scene.material.density * scene.gravity.g[0].hypot(scene.gravity.g[1]) * extent(1);
+    point.max(surface).max(weight) / e
+}
+
+/// What to tell the user when Newton could not get through a step even in the smallest piece:
+/// what in the scene makes the system ill-posed when something does, else the usual remedies.
+pub(super) fn divergence_advice(model: &crate::model::Model) -> String {
+    let scene = &model.scene;
+    let nu = scene.material.poisson;
+    if !model.mixed() && nu >= LOCKING_POISSON {
+        return format!(
+            "material.poisson = {nu} is nearly incompressible, where the displacement (P2) \
+             element locks at any step size: use the mixed element, solver.element = \"p2p1\""
+        );
+    }
+    let strain = load_strain(scene);
+    if strain > 1.0 {
+        return format!(
+            "the loads would strain the body by at least {strain:.1e} at this stiffness \
+             (material.young = {:e} Pa): no step size helps; check material.young against the \
+             loads (point_load forces in N per metre, pressures in Pa)",
+            scene.material.young
+        );
+    }
+    "a smaller step (steps.count) or another line search (solver.line_search) may get through"
+        .to_string()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -138,5 +197,21 @@ mod tests {
         r.size = [2.0, 2.0];
         scene.body.rectangles.push(r);
         assert_eq!(body_area(&scene), 10.0 + 2.0 * 2.0 - 1.0);
+    }
+
+    #[test]
+    fn divergence_advice_names_what_is_ill_posed() {
+        let model = |sets: &[&str]| {
+            let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+            let (scene, _) = crate::scene::load_scene("cantilever", &sets).unwrap();
+            crate::model::Model::new(&scene).unwrap()
+        };
+        assert!(divergence_advice(&model(&[])).contains("a smaller step"));
+        let locked = divergence_advice(&model(&["material.poisson=0.49999999"]));
+        assert!(locked.contains("solver.element = \"p2p1\""), "{locked}");
+        let mixed = model(&["material.poisson=0.49999999", "solver.element=\"p2p1\""]);
+        assert!(divergence_advice(&mixed).contains("a smaller step"));
+        let soft = divergence_advice(&model(&["material.young=1e-300"]));
+        assert!(soft.contains("material.young = 1e-300 Pa"), "{soft}");
     }
 }

@@ -112,7 +112,7 @@ impl Simulation {
             remapped: Default::default(),
         };
         if world.size() > 1 && !same_partition {
-            sim.repartition(world)?;
+            sim.repartition(world, Repartition::Always)?;
         }
         sim.restore_gauss(world, gauss);
         Ok(sim)
@@ -299,18 +299,31 @@ impl Simulation {
         }
     }
 
-    /// Collective. Repartitions with METIS when the load is out of balance.
+    /// Collective. Repartitions with METIS when the load is out of balance and a better balance
+    /// exists: with N particles on P ranks no partition beats ceil(N/P) on the largest rank (9
+    /// particles on 4 ranks stay at 3, 2, 2, 2).
     pub fn rebalance_if_needed(&mut self, world: &Comm) -> Result<(), String> {
-        if world.size() > 1 && imbalance(world, self.particles.len()) > IMBALANCE_LIMIT {
-            self.repartition(world)?;
+        if world.size() > 1 && super::test_hooks::rotate_partition() {
+            return self.repartition(world, Repartition::Rotated);
+        }
+        if world.size() == 1 || imbalance(world, self.particles.len()) <= IMBALANCE_LIMIT {
+            return Ok(());
+        }
+        let counts = rank_counts(world, self.particles.len());
+        let total: u64 = counts.iter().sum();
+        let best = total.div_ceil(counts.len() as u64);
+        if counts.iter().max().copied().unwrap_or(0) > best {
+            self.repartition(world, Repartition::IfBetter)?;
         }
         Ok(())
     }
 
-    /// Collective. METIS k-way on the mesh graph of the particles, then migration. Gauss states
-    /// are recovered from the particles afterwards, and the next predictor from the particle
-    /// increments.
-    fn repartition(&mut self, world: &Comm) -> Result<(), String> {
+    /// Collective. METIS k-way on the mesh graph of the particles, then migration (see
+    /// [`Repartition`] for when).
+    /// The Gauss states of the last
+    /// mesh, the Newton predictor at its nodes and the contact state go with the particles (by
+    /// triangle and node key, as on restart), so a repartition does not change the results.
+    fn repartition(&mut self, world: &Comm, mode: Repartition) -> Result<(), String> {
         let mesh = self.build_mesh(world)?;
         let n = mesh.n_owned;
         let mut adj: Vec<Vec<u64>> = vec![Vec::new(); n];
@@ -333,7 +346,24 @@ impl Simulation {
             adjncy.extend(a);
             xadj.push(adjncy.len());
         }
-        let dest = partition_graph(world, &self.particles.gid, &xadj, &adjncy).map_err(err)?;
+        let mut dest = partition_graph(world, &self.particles.gid, &xadj, &adjncy).map_err(err)?;
+        let size = world.size() as usize;
+        if mode == Repartition::Rotated {
+            dest.iter_mut().for_each(|r| *r = (*r + 1) % size as i32);
+        }
+        let mut to = vec![0.0; size];
+        for &r in &dest {
+            to[r as usize] += 1.0;
+        }
+        let now = rank_counts(world, self.particles.len());
+        let after = sum_f64(world, &to);
+        let largest = |c: &mut dyn Iterator<Item = f64>| c.fold(0.0, f64::max);
+        if mode == Repartition::IfBetter
+            && largest(&mut after.into_iter()) >= largest(&mut now.iter().map(|&c| c as f64))
+        {
+            return Ok(());
+        }
+        let records = self.gauss_records();
         let flags: Vec<u64> = self.particles.flags.iter().map(|&f| f as u64).collect();
         let (gid, rec, fl) = migrate(
             world,
@@ -346,10 +376,30 @@ impl Simulation {
         );
         self.particles =
             Particles::from_records(gid, &rec, fl.into_iter().map(|f| f as u32).collect());
-        self.tri_states = TriStates::default();
-        self.last_nodes.borrow_mut().clear();
+        self.restore_gauss(world, records);
         Ok(())
     }
+}
+
+/// When [`Simulation::repartition`] moves the particles.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Repartition {
+    /// To METIS's partition.
+    Always,
+    /// To METIS's partition if its largest rank is smaller than the current largest.
+    IfBetter,
+    /// To METIS's partition with every part on the next rank (`PFEM_TEST_REPARTITION`).
+    Rotated,
+}
+
+/// Collective. The particle count of every rank.
+fn rank_counts(world: &Comm, n_local: usize) -> Vec<u64> {
+    let mut mine = vec![0.0; world.size() as usize];
+    mine[world.rank() as usize] = n_local as f64;
+    sum_f64(world, &mine)
+        .into_iter()
+        .map(|c| c as u64)
+        .collect()
 }
 
 /// Debug builds: every particle within the halo width of an owned one is on this rank, checked

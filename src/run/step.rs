@@ -569,9 +569,9 @@ impl Simulation {
                 Err(SolveError::Diverged(msg)) => {
                     return Err(format!(
                         "{msg}, on a piece of 1/{} of the step after {cuts} cuts (from load \
-                         factor {from:.6}); a smaller step (steps.count) or another line \
-                         search (solver.line_search) may get through",
-                        (full / (to - from)).round()
+                         factor {from:.6}); {}",
+                        (full / (to - from)).round(),
+                        super::sanity::divergence_advice(&self.model)
                     ))
                 }
                 Err(e) => return Err(e.to_string()),

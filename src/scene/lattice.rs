@@ -275,6 +275,9 @@ poisson = 0.3
 [[point_load]]
 at = [0.0, 0.0]
 force = [0.0, -1.0]
+[[fixed]]
+where = "x >= 1"
+dofs = ["x", "y"]
 [steps]
 count = 1
 [history]

@@ -285,7 +285,7 @@ fn set_overrides_values() {
         "material.cu=50e3",
         "gravity.g=[0.0, -9.81]",
         "point_load[0].force=[0.0, -5.0e4]",
-        "fixed[0].dofs=[\"x\"]",
+        "fixed[0].dofs=[\"y\", \"x\"]",
         "mesh.h=1",
     ])
     .unwrap();
@@ -293,7 +293,7 @@ fn set_overrides_values() {
     assert_eq!(s.material.cu, 50e3);
     assert_eq!(s.gravity.g, [0.0, -9.81]);
     assert_eq!(s.point_load[0].force, [0.0, -5.0e4]);
-    assert_eq!(s.fixed[0].dofs, vec![Dof::X]);
+    assert_eq!(s.fixed[0].dofs, vec![Dof::Y, Dof::X]);
     assert_eq!(s.mesh.h, 1.0, "an integer is accepted for a number");
 }
 

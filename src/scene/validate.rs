@@ -343,7 +343,12 @@ fn check_against_particles(s: &Scene) -> Result<(), Invalid> {
             }
         }
     }
-    Ok(())
+    // The particle a point load goes to (`lattice::nearest`, ties to the smaller id).
+    let nearest = |at: [f64; 2]| {
+        let (gid, _) = lattice::nearest(&particles, at)?;
+        particles.gid.iter().position(|&g| g == gid)
+    };
+    super::validate_supports::check(s, &particles.position, tol, nearest)
 }
 
 pub fn validate(s: &Scene) -> Result<(), Invalid> {
