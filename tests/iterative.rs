@@ -108,9 +108,13 @@ fn iterative_footing_shallow_matches_the_direct_history_on_1_and_2_ranks() {
         let (diff, (newton, linear)) = direct_against_iterative(
             &dir,
             "footing-shallow",
-            &["mesh.h=0.1", "steps.count=40"],
+            &[
+                "mesh.h=0.5",
+                "mesh.fine=[{origin=[0.0,8.0],size=[4.0,2.0],h=0.25},\
+                 {origin=[0.5,9.5],size=[1.0,0.5],h=0.125}]",
+            ],
             ranks,
-            2,
+            3,
         );
         println!("footing-shallow, {ranks} ranks: max relative difference {diff:.2e}, {newton} Newton and {linear} linear iterations");
         assert!(diff < 1e-6, "{ranks} ranks: {diff:e}");
