@@ -41,6 +41,7 @@
 //! [solver]                   # optional
 //! newton_max_it = 25         # (default 25)
 //! newton_rtol = 1e-9         # (default 1e-9)
+//! linear = "auto"            # "auto" | "direct" | "iterative" (default "auto", by size)
 //! ```
 //!
 //! The field-by-field reference, with the validation rules, is on the types in [`schema`].
@@ -86,8 +87,8 @@ pub use rigid::{
 };
 pub use schema::{
     Body, Dof, ElementChoice, FineRegion, Fixed, Gravity, History, HistoryKind, LineSearch,
-    Material, MaterialModel, Mesh, Output, PointLoad, Prescribed, Rectangle, Scene, Selection,
-    Solver, Steps,
+    LinearChoice, Material, MaterialModel, Mesh, Output, PointLoad, Prescribed, Rectangle, Scene,
+    Selection, Solver, Steps,
 };
 pub use selector::{Axis, Comparison, Condition, Selector};
 

@@ -28,11 +28,6 @@ impl PetscError {
         }
         self
     }
-
-    /// Newton ran but did not converge, as opposed to a failing call.
-    pub fn is_divergence(&self) -> bool {
-        self.code == super::snes::DIVERGED
-    }
 }
 
 /// Turns a PETSc error code into a `Result`, with PETSc's own text for the code and the message

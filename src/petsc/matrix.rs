@@ -1,7 +1,11 @@
 use super::error::{check, PetscError};
 use super::ffi;
+use super::index_set::IndexSet;
+use super::nullspace::NullSpace;
+use super::{Int, Scalar};
 use mpi::raw::AsRaw;
 use mpi::topology::SimpleCommunicator;
+use std::marker::PhantomData;
 
 /// A distributed AIJ matrix we own, preallocated exactly; destroyed on drop.
 pub struct Mat {
@@ -9,59 +13,110 @@ pub struct Mat {
 }
 
 impl Mat {
-    /// Collective. MPIAIJ (SeqAIJ on one rank) with `n_local` owned rows and columns and exact
-    /// per-row counts of nonzeros in the diagonal (`d_nnz`) and off-diagonal (`o_nnz`) blocks.
-    /// Only owned rows may be set, and a value outside the preallocated pattern is an error: both
-    /// catch a wrong sparsity pattern instead of silently slowing down.
+    /// Collective. MPIAIJ (SeqAIJ on one rank) with `n_local` owned rows and columns, block size
+    /// `block` (rows of one node's displacement come in pairs: AMG then coarsens nodes, not
+    /// scalar dofs), and exact per-row counts of nonzeros in the diagonal (`d_nnz`) and
+    /// off-diagonal (`o_nnz`) blocks. Only owned rows may be set, and a value outside the
+    /// preallocated pattern is an error: both catch a wrong sparsity pattern instead of silently
+    /// slowing down.
     pub fn aij(
         comm: &SimpleCommunicator,
         n_local: usize,
-        d_nnz: &[i32],
-        o_nnz: &[i32],
+        block: usize,
+        d_nnz: &[usize],
+        o_nnz: &[usize],
     ) -> Result<Mat, PetscError> {
+        assert_eq!(d_nnz.len(), n_local, "one diagonal count per owned row");
+        assert_eq!(o_nnz.len(), n_local, "one off-diagonal count per owned row");
+        let ints = |v: &[usize]| {
+            v.iter()
+                .map(|&c| to_int(c, "nonzeros per row"))
+                .collect::<Result<Vec<Int>, _>>()
+        };
+        let (d_nnz, o_nnz) = (ints(d_nnz)?, ints(o_nnz)?);
         let mut raw: ffi::Mat = std::ptr::null_mut();
-        let n = n_local as ffi::PetscInt;
-        let det = ffi::PETSC_DETERMINE as ffi::PetscInt;
-        // SAFETY: nnz arrays have n_local entries and are copied by PETSc.
+        let n = to_int(n_local, "matrix rows")?;
+        let det = ffi::PETSC_DETERMINE as Int;
+        // SAFETY: out-pointer to a fresh handle, owned by `mat` from the next line on; the nnz
+        // arrays have n_local entries and are copied by PETSc. The block size must be set
+        // before preallocation, which fixes it.
         unsafe {
-            check(
-                ffi::MatCreateAIJ(
-                    comm.as_raw(),
-                    n,
-                    n,
-                    det,
-                    det,
-                    0,
-                    d_nnz.as_ptr(),
-                    0,
-                    o_nnz.as_ptr(),
-                    &mut raw,
-                ),
-                "MatCreateAIJ",
-            )?;
+            check(ffi::MatCreate(comm.as_raw(), &mut raw), "MatCreate")?;
             let mat = Mat { raw };
+            check(ffi::MatSetSizes(raw, n, n, det, det), "MatSetSizes")?;
+            let aij = super::init::cstring("aij")?;
+            check(ffi::MatSetType(raw, aij.as_ptr()), "MatSetType")?;
             check(
-                ffi::MatSetOption(
-                    mat.raw,
+                ffi::MatSetBlockSize(raw, to_int(block, "block size")?),
+                "MatSetBlockSize",
+            )?;
+            check(
+                ffi::MatSeqAIJSetPreallocation(raw, 0, d_nnz.as_ptr()),
+                "MatSeqAIJSetPreallocation",
+            )?;
+            check(
+                ffi::MatMPIAIJSetPreallocation(raw, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()),
+                "MatMPIAIJSetPreallocation",
+            )?;
+            for (option, name) in [
+                (
                     ffi::MatOption_MAT_NO_OFF_PROC_ENTRIES,
-                    ffi::PetscBool_PETSC_TRUE,
+                    "MatSetOption(MAT_NO_OFF_PROC_ENTRIES)",
                 ),
-                "MatSetOption(MAT_NO_OFF_PROC_ENTRIES)",
-            )?;
-            check(
-                ffi::MatSetOption(
-                    mat.raw,
+                (
                     ffi::MatOption_MAT_NEW_NONZERO_ALLOCATION_ERR,
-                    ffi::PetscBool_PETSC_TRUE,
+                    "MatSetOption(MAT_NEW_NONZERO_ALLOCATION_ERR)",
                 ),
-                "MatSetOption(MAT_NEW_NONZERO_ALLOCATION_ERR)",
-            )?;
+            ] {
+                check(
+                    ffi::MatSetOption(raw, option, ffi::PetscBool_PETSC_TRUE),
+                    name,
+                )?;
+            }
             Ok(mat)
         }
     }
 
-    pub fn as_ref(&self) -> MatRef {
-        MatRef { raw: self.raw }
+    pub fn as_ref(&self) -> MatRef<'_> {
+        MatRef {
+            raw: self.raw,
+            _owner: PhantomData,
+        }
+    }
+
+    /// Collective. The vectors an algebraic multigrid should interpolate exactly (the rigid-body
+    /// modes of elasticity); PETSc keeps its own reference.
+    pub fn set_near_null_space(&self, space: &NullSpace) -> Result<(), PetscError> {
+        // SAFETY: both handles are live.
+        check(
+            unsafe { ffi::MatSetNearNullSpace(self.raw, space.raw) },
+            "MatSetNearNullSpace",
+        )
+    }
+
+    /// Collective. The product `self * x` into `y`.
+    pub fn mult(&self, x: super::VecRef, y: super::VecRef) -> Result<(), PetscError> {
+        // SAFETY: live handles with matching layouts (PETSc checks the sizes).
+        check(unsafe { ffi::MatMult(self.raw, x.raw, y.raw) }, "MatMult")
+    }
+
+    /// Collective. The rows and columns `is` of this matrix (a block of a block system).
+    pub fn sub_matrix(&self, is: &IndexSet) -> Result<Mat, PetscError> {
+        let mut raw: ffi::Mat = std::ptr::null_mut();
+        // SAFETY: live handles; the new matrix is ours.
+        check(
+            unsafe {
+                ffi::MatCreateSubMatrix(
+                    self.raw,
+                    is.raw,
+                    is.raw,
+                    ffi::MatReuse_MAT_INITIAL_MATRIX,
+                    &mut raw,
+                )
+            },
+            "MatCreateSubMatrix",
+        )?;
+        Ok(Mat { raw })
     }
 }
 
@@ -74,29 +129,52 @@ impl Drop for Mat {
     }
 }
 
-/// A matrix lent to us by PETSc inside a Jacobian callback.
+/// A matrix borrowed for `'a`: from a `Mat` we own, or lent by PETSc for the length of a
+/// callback. The lifetime keeps the handle from outliving its owner.
 #[derive(Clone, Copy)]
-pub struct MatRef {
+pub struct MatRef<'a> {
     pub(crate) raw: ffi::Mat,
+    _owner: PhantomData<&'a ()>,
 }
 
-impl MatRef {
+impl MatRef<'_> {
+    /// A handle PETSc lends to a callback.
+    ///
+    /// # Safety
+    /// `raw` must be a live matrix for as long as the returned borrow is used; callbacks pass
+    /// it on only to code that cannot keep it (the borrow's lifetime ends with the callback).
+    pub(crate) unsafe fn lent<'a>(raw: ffi::Mat) -> MatRef<'a> {
+        MatRef {
+            raw,
+            _owner: PhantomData,
+        }
+    }
+
     pub fn zero_entries(&self) -> Result<(), PetscError> {
         // SAFETY: live matrix.
         check(unsafe { ffi::MatZeroEntries(self.raw) }, "MatZeroEntries")
     }
 
     /// Adds a dense block `vals` (row-major, rows.len() x cols.len()) at global `rows` x `cols`.
-    pub fn add_values(&self, rows: &[i32], cols: &[i32], vals: &[f64]) -> Result<(), PetscError> {
-        debug_assert_eq!(vals.len(), rows.len() * cols.len());
+    pub fn add_values(
+        &self,
+        rows: &[Int],
+        cols: &[Int],
+        vals: &[Scalar],
+    ) -> Result<(), PetscError> {
+        assert_eq!(
+            vals.len(),
+            rows.len() * cols.len(),
+            "a dense block of values"
+        );
         // SAFETY: slices are valid for the stated lengths; PETSc copies the values.
         check(
             unsafe {
                 ffi::MatSetValues(
                     self.raw,
-                    rows.len() as ffi::PetscInt,
+                    to_int(rows.len(), "rows")?,
                     rows.as_ptr(),
-                    cols.len() as ffi::PetscInt,
+                    to_int(cols.len(), "columns")?,
                     cols.as_ptr(),
                     vals.as_ptr(),
                     ffi::InsertMode_ADD_VALUES,
@@ -120,4 +198,16 @@ impl MatRef {
             )
         }
     }
+}
+
+/// A count or index as PETSc's integer, or an error when it does not fit (a 32-bit PETSc build
+/// and more than 2^31 unknowns).
+pub fn to_int(v: usize, what: &str) -> Result<Int, PetscError> {
+    Int::try_from(v).map_err(|_| PetscError {
+        code: -1,
+        message: format!(
+            "{what}: {v} does not fit PETSc's {}-bit integer (PetscInt)",
+            8 * std::mem::size_of::<Int>()
+        ),
+    })
 }

@@ -3,15 +3,32 @@
 
 pub mod error;
 pub mod ffi;
+pub mod index_set;
 pub mod init;
+pub mod linear;
 pub mod matrix;
+pub mod nullspace;
+pub mod reason;
 pub mod scatter;
 pub mod snes;
 pub mod vector;
 
+/// PETSc's integer as the bindings define it (32 or 64 bits by build): every index and count
+/// handed to PETSc has this type, converted with a check ([`matrix::to_int`]).
+pub type Int = ffi::PetscInt;
+/// PETSc's scalar as the bindings define it. The physics computes in f64, so a PETSc built
+/// with another scalar (single precision, complex) fails to compile here instead of
+/// reinterpreting memory.
+pub type Scalar = ffi::PetscScalar;
+const _: () = assert!(std::mem::size_of::<Scalar>() == std::mem::size_of::<f64>());
+
 pub use error::PetscError;
+pub use index_set::IndexSet;
 pub use init::Petsc;
-pub use matrix::Mat;
+pub use linear::LinearSolver;
+pub use matrix::{Mat, MatRef};
+pub use nullspace::NullSpace;
+pub use reason::{Divergence, KspDiverged, SnesDiverged, SolveFailure};
 pub use scatter::Scatter;
 pub use snes::{NonlinearProblem, Snes, SolveStats};
 pub use vector::{PVec, VecRef};

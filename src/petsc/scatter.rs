@@ -13,7 +13,10 @@ impl Scatter {
     /// Collective. `global_indices[i]` of `template`'s layout lands in local entry i.
     pub fn new(template: &PVec, global_indices: &[usize]) -> Result<Scatter, PetscError> {
         let local = PVec::seq(global_indices.len())?;
-        let from: Vec<ffi::PetscInt> = global_indices.iter().map(|&g| g as ffi::PetscInt).collect();
+        let from = global_indices
+            .iter()
+            .map(|&g| super::matrix::to_int(g, "scatter index"))
+            .collect::<Result<Vec<_>, _>>()?;
         let mut is_from: ffi::IS = std::ptr::null_mut();
         let mut raw: ffi::VecScatter = std::ptr::null_mut();
         // SAFETY: the index array is copied by PETSc (PETSC_COPY_VALUES); IS destroyed right after use.
@@ -21,7 +24,7 @@ impl Scatter {
             check(
                 ffi::ISCreateGeneral(
                     mpi::ffi::RSMPI_COMM_SELF,
-                    from.len() as ffi::PetscInt,
+                    super::matrix::to_int(from.len(), "scatter length")?,
                     from.as_ptr(),
                     ffi::PetscCopyMode_PETSC_COPY_VALUES,
                     &mut is_from,
@@ -45,7 +48,11 @@ impl Scatter {
     }
 
     /// Collective. Fetches the values and hands them to `f`.
-    pub fn gather<R>(&self, from: VecRef, f: impl FnOnce(&[f64]) -> R) -> Result<R, PetscError> {
+    pub fn gather<R>(
+        &self,
+        from: VecRef<'_>,
+        f: impl FnOnce(&[super::Scalar]) -> R,
+    ) -> Result<R, PetscError> {
         // SAFETY: both vectors are live and match the layouts the scatter was built for.
         unsafe {
             check(

@@ -1,11 +1,13 @@
 use super::error::{check, PetscError};
 use super::ffi;
 use super::init::cstring;
-use super::matrix::{Mat, MatRef};
+use super::linear::LinearSolver;
+use super::matrix::{to_int, Mat, MatRef};
+use super::reason::{Divergence, KspDiverged, SnesDiverged, SolveFailure};
 use super::vector::{PVec, VecRef};
 use mpi::raw::AsRaw;
 use mpi::topology::SimpleCommunicator;
-use std::ffi::{c_void, CStr};
+use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 /// Why a callback could not evaluate.
@@ -21,9 +23,9 @@ pub enum CallbackError {
 /// context: SNES calls back into these with its current iterate.
 pub trait NonlinearProblem {
     /// Collective. Residual F(x) into the owned entries of `f`.
-    fn residual(&mut self, x: VecRef, f: VecRef) -> Result<(), CallbackError>;
+    fn residual(&mut self, x: VecRef<'_>, f: VecRef<'_>) -> Result<(), CallbackError>;
     /// Collective. Consistent tangent dF/dx at `x` into `j` (assembled on return).
-    fn jacobian(&mut self, x: VecRef, j: MatRef) -> Result<(), CallbackError>;
+    fn jacobian(&mut self, x: VecRef<'_>, j: MatRef<'_>) -> Result<(), CallbackError>;
 }
 
 /// Newton's outcome.
@@ -50,21 +52,19 @@ const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
 /// can lie below round-off.
 const STEP_TOL: f64 = 1e-10;
 
-/// Not a PETSc code: SNES ran but did not converge (a smaller step may).
-pub const DIVERGED: ffi::PetscErrorCode = -1001;
-
 impl Snes {
-    /// Collective. Newton with full steps and a direct LU solve by MUMPS by default: robust for the
-    /// indefinite saddle points of nearly incompressible soil and fast on 1-3 ranks, where
-    /// SuperLU_dist stalled on 3 oversubscribed ranks. MUMPS on several ranks sums contribution
-    /// blocks in message-arrival order, so two identical multi-rank runs agree to round-off, not
-    /// bit for bit; `-pc_factor_mat_solver_type superlu_dist` is bitwise reproducible on 2 ranks.
-    /// Every choice is overridable by PETSc options on the command line.
+    /// Collective. Newton with the caller's line search and linear solver. The direct solver
+    /// (MUMPS LU) is robust for the indefinite saddle points of nearly incompressible soil and
+    /// fast on 1-3 ranks, where SuperLU_dist stalled on 3 oversubscribed ranks. MUMPS on several
+    /// ranks sums contribution blocks in message-arrival order, so two identical multi-rank runs
+    /// agree to round-off, not bit for bit; `-pc_factor_mat_solver_type superlu_dist` is bitwise
+    /// reproducible on 2 ranks. Every choice is overridable by PETSc options on the command line.
     pub fn new(
         comm: &SimpleCommunicator,
         rtol: f64,
         max_it: usize,
         line_search: &str,
+        linear: &LinearSolver,
     ) -> Result<Snes, PetscError> {
         let mut raw: ffi::SNES = std::ptr::null_mut();
         // SAFETY: fresh handle; KSP/PC are borrowed from the SNES and not destroyed by us.
@@ -72,22 +72,19 @@ impl Snes {
             check(ffi::SNESCreate(comm.as_raw(), &mut raw), "SNESCreate")?;
             let snes = Snes { raw };
             check(
-                ffi::SNESSetTolerances(raw, 1e-50, rtol, STEP_TOL, max_it as ffi::PetscInt, 10_000),
+                ffi::SNESSetTolerances(
+                    raw,
+                    1e-50,
+                    rtol,
+                    STEP_TOL,
+                    to_int(max_it, "solver.newton_max_it")?,
+                    10_000,
+                ),
                 "SNESSetTolerances",
             )?;
             let mut ksp: ffi::KSP = std::ptr::null_mut();
             check(ffi::SNESGetKSP(raw, &mut ksp), "SNESGetKSP")?;
-            let preonly = cstring("preonly")?;
-            check(ffi::KSPSetType(ksp, preonly.as_ptr()), "KSPSetType")?;
-            let mut pc: ffi::PC = std::ptr::null_mut();
-            check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
-            let lu = cstring("lu")?;
-            check(ffi::PCSetType(pc, lu.as_ptr()), "PCSetType")?;
-            let direct = cstring("mumps")?;
-            check(
-                ffi::PCFactorSetMatSolverType(pc, direct.as_ptr()),
-                "PCFactorSetMatSolverType",
-            )?;
+            linear.configure(ksp)?;
             // The caller's line search: full steps for elastic large rotations (the residual grows
             // on the first iterate before the quadratic phase, and backtracking would crawl),
             // backtracking for plastic flow (elastic-plastic switching overshoots).
@@ -110,7 +107,7 @@ impl Snes {
         problem: &mut dyn NonlinearProblem,
         x: &PVec,
         jac: &Mat,
-    ) -> Result<SolveStats, PetscError> {
+    ) -> Result<SolveStats, SolveFailure> {
         let r = x.duplicate()?;
         let mut ctx = Ctx {
             problem,
@@ -134,10 +131,10 @@ impl Snes {
             )
         };
         if let Some(msg) = ctx.error.take() {
-            return Err(PetscError {
+            return Err(SolveFailure::Failed(PetscError {
                 code: PETSC_ERR_USER,
                 message: msg,
-            });
+            }));
         }
         solved?;
         let mut reason: ffi::SNESConvergedReason = 0;
@@ -177,32 +174,38 @@ impl Snes {
             // A tiny update is convergence only when the line search took (about) the whole
             // Newton step; a strongly damped step is tiny because Newton is stuck, whatever the
             // residual.
+            let (iterations, residual) = (its.max(0) as usize, norm);
             if lambda < 0.5 {
-                return Err(PetscError {
-                    code: DIVERGED,
-                    message: format!("Newton stalled (update below {STEP_TOL:e} of the solution after a step damped to {lambda:.1e}) after {its} iterations, residual {norm:.3e}"),
-                });
+                return Err(SolveFailure::Diverged(Divergence::Stalled {
+                    lambda,
+                    step_tol: STEP_TOL,
+                    iterations,
+                    residual,
+                }));
             }
-            if reason < 0 {
-                let mut text: *const std::os::raw::c_char = std::ptr::null();
-                check(
-                    ffi::SNESGetConvergedReasonString(self.raw, &mut text),
-                    "SNESGetConvergedReasonString",
-                )?;
-                let why = if text.is_null() {
-                    format!("reason {reason}")
-                } else {
-                    CStr::from_ptr(text).to_string_lossy().into_owned()
-                };
-                return Err(PetscError {
-                    code: DIVERGED,
-                    message: format!("Newton did not converge ({why}) after {its} iterations, residual {norm:.3e}"),
-                });
+            if let Some(reason) = SnesDiverged::from_raw(reason) {
+                let mut linear = None;
+                if reason == SnesDiverged::LinearSolve {
+                    let mut ksp: ffi::KSP = std::ptr::null_mut();
+                    check(ffi::SNESGetKSP(self.raw, &mut ksp), "SNESGetKSP")?;
+                    let mut kr: ffi::KSPConvergedReason = 0;
+                    check(
+                        ffi::KSPGetConvergedReason(ksp, &mut kr),
+                        "KSPGetConvergedReason",
+                    )?;
+                    linear = KspDiverged::from_raw(kr);
+                }
+                return Err(SolveFailure::Diverged(Divergence::Snes {
+                    reason,
+                    linear,
+                    iterations,
+                    residual,
+                }));
             }
         }
         Ok(SolveStats {
-            newton_iterations: its as usize,
-            linear_iterations: lits as usize,
+            newton_iterations: its.max(0) as usize,
+            linear_iterations: lits.max(0) as usize,
             residual_norm: norm,
         })
     }
@@ -259,7 +262,9 @@ unsafe extern "C" fn residual_cb(
     // SAFETY: ctx is the `Ctx` that `Snes::solve` keeps alive during SNESSolve.
     let ctx = unsafe { &mut *(ctx as *mut Ctx) };
     let outcome = catch_unwind(AssertUnwindSafe(|| {
-        ctx.problem.residual(VecRef { raw: x }, VecRef { raw: f })
+        // SAFETY: PETSc keeps x and f alive during the callback, and the borrows end with it.
+        let (x, f) = unsafe { (VecRef::lent(x), VecRef::lent(f)) };
+        ctx.problem.residual(x, f)
     }));
     report(snes, ctx, outcome)
 }
@@ -274,7 +279,9 @@ unsafe extern "C" fn jacobian_cb(
     // SAFETY: as in `residual_cb`.
     let ctx = unsafe { &mut *(ctx as *mut Ctx) };
     let outcome = catch_unwind(AssertUnwindSafe(|| {
-        ctx.problem.jacobian(VecRef { raw: x }, MatRef { raw: j })
+        // SAFETY: as for the residual.
+        let (x, j) = unsafe { (VecRef::lent(x), MatRef::lent(j)) };
+        ctx.problem.jacobian(x, j)
     }));
     report(snes, ctx, outcome)
 }

@@ -1,17 +1,22 @@
 use super::error::{check, PetscError};
 use super::ffi;
+use super::{Int, Scalar};
 use mpi::raw::AsRaw;
 use mpi::topology::SimpleCommunicator;
+use std::marker::PhantomData;
 
 /// A PETSc vector we own; destroyed on drop.
 pub struct PVec {
     pub(crate) raw: ffi::Vec,
 }
 
-/// A PETSc vector lent to us by PETSc (inside a callback); never destroyed by us.
+/// A vector borrowed for `'a`: from a `PVec` we own, or lent by PETSc for the length of a
+/// callback; never destroyed through this handle, and the lifetime keeps it from outliving its
+/// owner.
 #[derive(Clone, Copy)]
-pub struct VecRef {
+pub struct VecRef<'a> {
     pub(crate) raw: ffi::Vec,
+    _owner: PhantomData<&'a ()>,
 }
 
 impl PVec {
@@ -23,8 +28,8 @@ impl PVec {
             unsafe {
                 ffi::VecCreateMPI(
                     comm.as_raw(),
-                    n_local as ffi::PetscInt,
-                    ffi::PETSC_DETERMINE as ffi::PetscInt,
+                    super::matrix::to_int(n_local, "vector length")?,
+                    ffi::PETSC_DETERMINE as Int,
                     &mut raw,
                 )
             },
@@ -38,7 +43,13 @@ impl PVec {
         let mut raw: ffi::Vec = std::ptr::null_mut();
         // SAFETY: out-pointer to a fresh handle; PETSC_COMM_SELF is MPI_COMM_SELF.
         check(
-            unsafe { ffi::VecCreateSeq(mpi::ffi::RSMPI_COMM_SELF, n as ffi::PetscInt, &mut raw) },
+            unsafe {
+                ffi::VecCreateSeq(
+                    mpi::ffi::RSMPI_COMM_SELF,
+                    super::matrix::to_int(n, "vector length")?,
+                    &mut raw,
+                )
+            },
             "VecCreateSeq",
         )?;
         Ok(PVec { raw })
@@ -55,8 +66,11 @@ impl PVec {
         Ok(PVec { raw })
     }
 
-    pub fn as_ref(&self) -> VecRef {
-        VecRef { raw: self.raw }
+    pub fn as_ref(&self) -> VecRef<'_> {
+        VecRef {
+            raw: self.raw,
+            _owner: PhantomData,
+        }
     }
 }
 
@@ -69,11 +83,22 @@ impl Drop for PVec {
     }
 }
 
-impl VecRef {
+impl VecRef<'_> {
+    /// A handle PETSc lends to a callback.
+    ///
+    /// # Safety
+    /// `raw` must be a live vector for as long as the returned borrow is used.
+    pub(crate) unsafe fn lent<'a>(raw: ffi::Vec) -> VecRef<'a> {
+        VecRef {
+            raw,
+            _owner: PhantomData,
+        }
+    }
+
     /// The locally owned entries, read-only.
-    pub fn read<R>(&self, f: impl FnOnce(&[f64]) -> R) -> Result<R, PetscError> {
+    pub fn read<R>(&self, f: impl FnOnce(&[Scalar]) -> R) -> Result<R, PetscError> {
         let n = self.local_size()?;
-        let mut ptr: *const f64 = std::ptr::null();
+        let mut ptr: *const Scalar = std::ptr::null();
         // SAFETY: PETSc hands out the local array until the matching restore call.
         check(
             unsafe { ffi::VecGetArrayRead(self.raw, &mut ptr) },
@@ -93,9 +118,9 @@ impl VecRef {
     }
 
     /// The locally owned entries, writable.
-    pub fn write<R>(&self, f: impl FnOnce(&mut [f64]) -> R) -> Result<R, PetscError> {
+    pub fn write<R>(&self, f: impl FnOnce(&mut [Scalar]) -> R) -> Result<R, PetscError> {
         let n = self.local_size()?;
-        let mut ptr: *mut f64 = std::ptr::null_mut();
+        let mut ptr: *mut Scalar = std::ptr::null_mut();
         // SAFETY: as in `read`; no other borrow of this array exists while `f` runs.
         check(
             unsafe { ffi::VecGetArray(self.raw, &mut ptr) },
@@ -115,12 +140,15 @@ impl VecRef {
     }
 
     pub fn local_size(&self) -> Result<usize, PetscError> {
-        let mut n: ffi::PetscInt = 0;
+        let mut n: Int = 0;
         // SAFETY: live vector.
         check(
             unsafe { ffi::VecGetLocalSize(self.raw, &mut n) },
             "VecGetLocalSize",
         )?;
-        Ok(n as usize)
+        usize::try_from(n).map_err(|_| PetscError {
+            code: -1,
+            message: format!("VecGetLocalSize: negative size {n}"),
+        })
     }
 }

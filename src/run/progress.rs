@@ -30,6 +30,7 @@ pub struct Progress {
     total: u64,
     started: Instant,
     newton: usize,
+    linear: usize,
     contact: f64,
 }
 
@@ -42,12 +43,14 @@ impl Progress {
             total,
             started: Instant::now(),
             newton: 0,
+            linear: 0,
             contact: 0.0,
         }
     }
 
     pub fn step(&mut self, sim: &Simulation, r: &StepReport, t: &PhaseTimer) {
         self.newton += r.newton_iterations;
+        self.linear += r.linear_iterations;
         self.contact += r.contact_seconds;
         let step = sim.step();
         if !self.root || (!step.is_multiple_of(self.every) && step != self.total) {
@@ -62,11 +65,12 @@ impl Progress {
         let left =
             (self.total - step) as f64 * self.started.elapsed().as_secs_f64() / done.max(1.0);
         println!(
-            "step {step:>5}/{} load {:.4} newton {:>2}{} |R| {:.2e} particles {} triangles {} remapped {} | {} (contact {:.3}, augmentations {}) | step {:.3}s left {:.0}s",
+            "step {step:>5}/{} load {:.4} newton {:>2}{} linear {} |R| {:.2e} particles {} triangles {} remapped {} | {} (contact {:.3}, augmentations {}) | step {:.3}s left {:.0}s",
             self.total,
             sim.load_factor(),
             r.newton_iterations,
             if r.cuts > 0 { format!(" (cut {}x)", r.cuts) } else { String::new() },
+            r.linear_iterations,
             r.residual_norm,
             r.particles,
             r.triangles,
@@ -82,10 +86,11 @@ impl Progress {
     pub fn finish(&self, sim: &Simulation) {
         if self.root {
             println!(
-                "done: step {} in {:.2} s, {} Newton iterations, contact {:.2} s",
+                "done: step {} in {:.2} s, {} Newton iterations, {} linear iterations, contact {:.2} s",
                 sim.step(),
                 self.started.elapsed().as_secs_f64(),
                 self.newton,
+                self.linear,
                 self.contact
             );
         }

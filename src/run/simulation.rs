@@ -50,6 +50,8 @@ pub struct Simulation {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct StepReport {
     pub newton_iterations: usize,
+    /// Krylov iterations of the step's linear solves (one per Newton iteration when direct).
+    pub linear_iterations: usize,
     /// Times the step's increment was halved after a Newton divergence.
     pub cuts: usize,
     pub residual_norm: f64,

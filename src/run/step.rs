@@ -5,9 +5,12 @@ use super::{Simulation, StepReport};
 use crate::mapping::{recover_at_particles, TriStates};
 use crate::material::GaussState;
 use crate::mesh::LocalMesh;
-use crate::petsc::{Mat, PVec, Petsc, Snes};
-use crate::scene::LineSearch;
-use crate::solve::{Constraints, DofMap, StepProblem, StepSetup};
+use crate::petsc::{
+    IndexSet, LinearSolver, Mat, NullSpace, PVec, Petsc, PetscError, Snes, SolveFailure,
+};
+use crate::scene::{LineSearch, LinearChoice};
+use crate::solve::nullspace::orthonormal_rigid_body_modes;
+use crate::solve::{Constraints, DofMap, FieldLayout, SchurPreconditioner, StepProblem, StepSetup};
 use pfem_partition::{max_f64, sum_f64, Comm};
 
 /// PETSc objects reused across increments with the same matrix pattern.
@@ -15,8 +18,28 @@ pub struct SolverObjects {
     signature: u64,
     x: PVec,
     jac: Mat,
+    /// The iterative path's extras: the near-null space (attached to `jac` for P2, to the
+    /// displacement field for P2–P1) and the field split of a mixed system.
+    amg: bool,
+    near_null: Option<NullSpace>,
+    split: Option<Split>,
     snes: Snes,
 }
+
+/// The Schur-complement field split of a mixed system.
+struct Split {
+    layout: FieldLayout,
+    _displacement: IndexSet,
+    _pressure: IndexSet,
+    pressure_mass: Mat,
+}
+
+/// Global dofs from which `solver.linear = "auto"` solves iteratively: the crossover of the
+/// two paths measured on the cantilever (bench/solver_scaling.sh, 2-core machine).
+const ITERATIVE_ABOVE_DOFS: usize = 60_000;
+/// Relative tolerance of an iterative linear solve: tight enough that Newton's iterates, and
+/// so the histories, match the direct solver's (measured, tests/iterative.rs).
+const LINEAR_RTOL: f64 = 1e-8;
 
 /// FNV-1a over the global dof numbers of every local triangle: equal signatures mean the same
 /// matrix pattern on this rank.
@@ -70,6 +93,8 @@ pub struct Solved {
     /// Pressure and shear of every contact node at the solution.
     contact_state: super::contact::ContactState,
     newton_iterations: usize,
+    /// Krylov iterations of the increment's linear solves (1 per Newton iteration when direct).
+    linear_iterations: usize,
     residual_norm: f64,
     /// Newton solves after the first (contact augmentations), all ranks.
     augmentations: usize,
@@ -181,7 +206,7 @@ impl Simulation {
             surface: loads.surface,
         };
         let mut cache = self
-            .solver_objects(world, &dofs)
+            .solver_objects(world, mesh, &dofs)
             .map_err(|e| err(e.to_string()))?;
         let outcome = self.solve_with(
             world, mesh, &dofs, setup, &spacing, &mut cache, scale, from, step,
@@ -199,6 +224,7 @@ impl Simulation {
             body_force: o.body_force,
             contact_state: o.contact_state,
             newton_iterations: o.stats.newton_iterations,
+            linear_iterations: o.stats.linear_iterations,
             residual_norm: o.stats.residual_norm,
             augmentations: o.augmentations,
         })
@@ -210,6 +236,7 @@ impl Simulation {
     fn solver_objects(
         &self,
         world: &Comm,
+        mesh: &LocalMesh,
         dofs: &DofMap,
     ) -> Result<SolverObjects, crate::petsc::PetscError> {
         // A different line search is a different SNES.
@@ -225,7 +252,7 @@ impl Simulation {
         drop(cached);
         let x = PVec::mpi(world, dofs.n_owned_dofs)?;
         let (d_nnz, o_nnz) = dofs.preallocation();
-        let jac = Mat::aij(world, dofs.n_owned_dofs, &d_nnz, &o_nnz)?;
+        let jac = Mat::aij(world, dofs.n_owned_dofs, dofs.block_size(), &d_nnz, &o_nnz)?;
         let solver = &self.model.scene.solver;
         let line_search = match solver.line_search {
             LineSearch::Auto if self.model.plastic() => "bt",
@@ -242,17 +269,75 @@ impl Simulation {
             (true, "bt") => "basic",
             (true, _) => "bt",
         };
+        let iterative = match solver.linear {
+            LinearChoice::Direct => false,
+            LinearChoice::Iterative => true,
+            // The field split is left to an explicit choice: at yield its displacement block
+            // loses the stiffness AMG needs (bench/VALIDATION.md, "Iterative linear solver").
+            LinearChoice::Auto => {
+                dofs.vertex_dofs == 2 && dofs.n_global_dofs > ITERATIVE_ABOVE_DOFS
+            }
+        };
+        let split = if iterative && dofs.vertex_dofs == 3 {
+            Some(self.field_split(world, mesh, dofs)?)
+        } else {
+            None
+        };
+        let linear = match &split {
+            Some(s) => LinearSolver::Schur {
+                rtol: LINEAR_RTOL,
+                displacement: &s._displacement,
+                pressure: &s._pressure,
+                pressure_mass: &s.pressure_mass,
+            },
+            None if iterative => LinearSolver::Amg { rtol: LINEAR_RTOL },
+            None => LinearSolver::Direct,
+        };
         let snes = Snes::new(
             world,
             solver.newton_rtol,
             solver.newton_max_it as usize,
             line_search,
+            &linear,
         )?;
         Ok(SolverObjects {
             signature,
             x,
             jac,
+            amg: iterative && split.is_none(),
+            near_null: None,
+            split,
             snes,
+        })
+    }
+
+    /// Collective. The index sets of the displacement and pressure fields of a mixed system,
+    /// the rigid-body near-null space of the displacement field, and the (empty) pressure mass
+    /// matrix the Jacobian assembles for the Schur complement.
+    fn field_split(
+        &self,
+        world: &Comm,
+        mesh: &LocalMesh,
+        dofs: &DofMap,
+    ) -> Result<Split, PetscError> {
+        let layout = FieldLayout::new(world, dofs);
+        let ints = |v: &[usize]| {
+            v.iter()
+                .map(|&g| crate::petsc::matrix::to_int(g, "dof"))
+                .collect::<Result<Vec<_>, _>>()
+        };
+        let displacement = IndexSet::general(world, &ints(&layout.displacement)?, 2)?;
+        let pressure = IndexSet::general(world, &ints(&layout.pressure)?, 1)?;
+        let modes = orthonormal_rigid_body_modes(world, &dofs.owned_coordinates(&mesh.points));
+        let space = NullSpace::new(world, layout.displacement.len(), &modes)?;
+        displacement.compose_near_null_space(&space)?;
+        let n_p = layout.pressure.len();
+        let pressure_mass = Mat::aij(world, n_p, 1, &layout.mass_d_nnz, &layout.mass_o_nnz)?;
+        Ok(Split {
+            layout,
+            _displacement: displacement,
+            _pressure: pressure,
+            pressure_mass,
         })
     }
 
@@ -270,9 +355,30 @@ impl Simulation {
         step: u64,
     ) -> Result<Outcome, SolveError> {
         let err = |e: String| SolveError::Fatal(e);
-        let SolverObjects { x, jac, snes, .. } = objects;
+        let SolverObjects {
+            x,
+            jac,
+            snes,
+            amg,
+            near_null,
+            split,
+            ..
+        } = objects;
         let mut problem =
             StepProblem::new(world, mesh, dofs, setup, x).map_err(|e| err(e.to_string()))?;
+        if let Some(split) = split {
+            problem = problem.with_schur_preconditioner(SchurPreconditioner {
+                matrix: &split.pressure_mass,
+                pressure_index: &split.layout.pressure_index,
+            });
+        } else if *amg {
+            // The modes at this increment's start: the nodes moved since the matrix was made.
+            let modes = orthonormal_rigid_body_modes(world, &dofs.owned_coordinates(&mesh.points));
+            let space = NullSpace::new(world, dofs.n_owned_dofs, &modes)
+                .and_then(|space| jac.set_near_null_space(&space).map(|()| space))
+                .map_err(|e| err(e.to_string()))?;
+            *near_null = Some(space);
+        }
         // Predictor: the last step's increment (a proportional step's best guess, which also keeps
         // Newton off the zero-energy shear-band modes of a plastic limit state) and the current
         // pressure: the last solution's own nodal values where the node survived the remesh (a
@@ -303,13 +409,9 @@ impl Simulation {
             })
             .map_err(|e| err(e.to_string()))?;
         let mut newton = |problem: &mut StepProblem, x: &mut PVec, jac: &mut Mat| {
-            snes.solve(problem, x, jac).map_err(|e| {
-                let msg = format!("step {step}: {}", e.message);
-                if e.is_divergence() {
-                    SolveError::Diverged(msg)
-                } else {
-                    SolveError::Fatal(msg)
-                }
+            snes.solve(problem, x, jac).map_err(|e| match e {
+                SolveFailure::Diverged(d) => SolveError::Diverged(format!("step {step}: {d}")),
+                SolveFailure::Failed(e) => SolveError::Fatal(format!("step {step}: {}", e.message)),
             })
         };
         let mut stats = newton(&mut problem, x, jac)?;
@@ -346,6 +448,7 @@ impl Simulation {
                 augmentations += 1;
                 let more = newton(&mut problem, x, jac)?;
                 stats.newton_iterations += more.newton_iterations;
+                stats.linear_iterations += more.linear_iterations;
                 stats.residual_norm = more.residual_norm;
             }
         }
@@ -490,6 +593,7 @@ impl Simulation {
         );
         Ok(StepReport {
             newton_iterations: solved.newton_iterations,
+            linear_iterations: solved.linear_iterations,
             cuts: 0,
             residual_norm: solved.residual_norm,
             particles: counts[0] as u64,
@@ -530,7 +634,7 @@ impl Simulation {
         let mut from = self.header.load_factor;
         let mut piece = full;
         let mut states = states;
-        let (mut cuts, mut newton, mut remapped) = (0, 0, 0);
+        let (mut cuts, mut newton, mut linear, mut remapped) = (0, 0, 0, 0);
         loop {
             let to = if from + piece >= target - 1e-9 * full {
                 target
@@ -544,9 +648,11 @@ impl Simulation {
                     let mut report = self.update(world, mesh, solved, completes)?;
                     report.penetration = self.check_penetration(world)?;
                     newton += report.newton_iterations;
+                    linear += report.linear_iterations;
                     remapped += report.remapped;
                     if completes {
                         report.newton_iterations = newton;
+                        report.linear_iterations = linear;
                         report.remapped = remapped;
                         report.augmentations = self.augmentations.take() as usize;
                         report.contact_seconds = self.contact_seconds.take();

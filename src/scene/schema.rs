@@ -356,6 +356,22 @@ pub struct Solver {
     /// residual norm, more evaluations per iteration but it carries localised plastic flow
     /// further) or `"cp"`. `-snes_linesearch_type` on the command line overrides it.
     pub line_search: LineSearch,
+    /// Newton's linear solver: `"auto"` (default: direct below a size measured as the
+    /// crossover on a 2-core machine, iterative above), `"direct"` (MUMPS LU) or `"iterative"`
+    /// (GMRES with algebraic multigrid for `"p2"`; with a Schur-complement field split, AMG on
+    /// the displacements and the pressure mass matrix scaled by 1/G on the pressures, for
+    /// `"p2p1"`). PETSc options on the command line (`-ksp_type`, `-pc_type`, ...) override it.
+    pub linear: LinearChoice,
+}
+
+/// `solver.linear`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LinearChoice {
+    #[default]
+    Auto,
+    Direct,
+    Iterative,
 }
 
 /// `solver.line_search`.
@@ -387,6 +403,7 @@ impl Default for Solver {
             newton_rtol: 1e-9,
             element: ElementChoice::Auto,
             line_search: LineSearch::Auto,
+            linear: LinearChoice::Auto,
         }
     }
 }

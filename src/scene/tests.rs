@@ -406,3 +406,14 @@ fn line_search_is_a_named_choice() {
     let e = with_sets(&["solver.line_search=\"newton\""]).unwrap_err();
     assert_eq!(e.field.as_deref(), Some("solver.line_search"), "{e}");
 }
+
+#[test]
+fn linear_solver_is_a_named_choice() {
+    let s = with_sets(&[]).unwrap();
+    assert_eq!(s.solver.linear, LinearChoice::Auto);
+    let s = with_sets(&["solver.linear=\"iterative\""]).unwrap();
+    assert_eq!(s.solver.linear, LinearChoice::Iterative);
+    let e = with_sets(&["solver.linear=\"gmres\""]).unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("solver.linear"), "{e}");
+    assert!(e.to_string().contains("gmres"), "{e}");
+}

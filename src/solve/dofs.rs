@@ -189,6 +189,29 @@ impl DofMap {
         }
     }
 
+    /// Block size of the system: 2 (a node's ux, uy) for displacement-only dofs; 1 for mixed
+    /// dofs, whose vertex nodes carry three unknowns and midside nodes two.
+    pub fn block_size(&self) -> usize {
+        if self.vertex_dofs == 2 {
+            2
+        } else {
+            1
+        }
+    }
+
+    /// Positions of this rank's owned nodes in the order of their dofs (a vertex at its
+    /// particle in `points`, a midside node at its chord's midpoint): where the rigid-body
+    /// modes are evaluated.
+    pub fn owned_coordinates(&self, points: &[[f64; 2]]) -> Vec<[f64; 2]> {
+        (0..self.n_nodes())
+            .filter(|&n| self.node_owned[n])
+            .map(|n| {
+                let [a, b] = self.node_points(n).map(|p| points[p as usize]);
+                [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]
+            })
+            .collect()
+    }
+
     /// Global indices of the local vector (node order): what the scatter gathers.
     pub fn local_to_global(&self) -> Vec<usize> {
         (0..self.n_nodes())
@@ -198,7 +221,7 @@ impl DofMap {
 
     /// Exact nonzero counts per owned row in the diagonal and off-diagonal blocks, from the mesh
     /// graph: every triangle around an owned node is on this rank.
-    pub fn preallocation(&self) -> (Vec<i32>, Vec<i32>) {
+    pub fn preallocation(&self) -> (Vec<usize>, Vec<usize>) {
         let mut cols: Vec<Vec<u32>> = vec![Vec::new(); self.n_nodes()];
         for nodes in &self.tri_nodes {
             for &r in nodes {
@@ -207,8 +230,8 @@ impl DofMap {
                 }
             }
         }
-        let mut d = vec![0i32; self.n_owned_dofs];
-        let mut o = vec![0i32; self.n_owned_dofs];
+        let mut d = vec![0; self.n_owned_dofs];
+        let mut o = vec![0; self.n_owned_dofs];
         for (r, c) in cols.iter_mut().enumerate() {
             if !self.node_owned[r] {
                 continue;
@@ -217,7 +240,7 @@ impl DofMap {
             c.dedup();
             let (mut nd, mut no) = (0, 0);
             for &n in c.iter() {
-                let k = self.ndof(n as usize) as i32;
+                let k = self.ndof(n as usize);
                 if self.node_owned[n as usize] {
                     nd += k;
                 } else {

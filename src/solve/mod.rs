@@ -3,8 +3,11 @@
 
 pub mod constraints;
 pub mod dofs;
+pub mod nullspace;
 pub mod problem;
+pub mod split;
 
 pub use constraints::Constraints;
 pub use dofs::DofMap;
-pub use problem::{Kernel, StepProblem, StepSetup};
+pub use problem::{Kernel, SchurPreconditioner, StepProblem, StepSetup};
+pub use split::FieldLayout;

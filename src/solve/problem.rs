@@ -10,10 +10,12 @@ use crate::fem::p2::straight_sided;
 use crate::fem::surface_load::edge_pressure;
 use crate::material::{GaussState, Material};
 use crate::mesh::LocalMesh;
+use crate::petsc::matrix::{to_int, MatRef};
 use crate::petsc::snes::{CallbackError, NonlinearProblem};
-use crate::petsc::{matrix::MatRef, PVec, PetscError, Scatter, VecRef};
+use crate::petsc::{Int, Mat, PVec, PetscError, Scatter, VecRef};
 use crate::rigid::{pair_force, ContactPair, PairForce, Shape};
 use pfem_partition::{agree_on_error, Comm};
+use std::cell::Cell;
 
 /// The element family of a step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,6 +76,19 @@ pub struct StepProblem<'a> {
     geometry: Vec<[[f64; 2]; 6]>,
     /// Local-vector index of every element dof, per triangle.
     element_dofs: Vec<Vec<usize>>,
+    /// The diagonal of a constrained row: the mean diagonal of the free displacement rows, so
+    /// that the constrained rows neither stand out of an AMG hierarchy nor spoil the
+    /// conditioning (fixed on the first evaluation of the increment).
+    diagonal: Cell<Option<f64>>,
+    /// Where the Jacobian also assembles the Schur-complement preconditioner.
+    schur: Option<SchurPreconditioner<'a>>,
+}
+
+/// The pressure mass matrix scaled by −1/G that a Schur-complement preconditioner uses, and
+/// each local node's row in it.
+pub struct SchurPreconditioner<'a> {
+    pub matrix: &'a Mat,
+    pub pressure_index: &'a [usize],
 }
 
 impl<'a> StepProblem<'a> {
@@ -114,7 +129,15 @@ impl<'a> StepProblem<'a> {
             scatter,
             geometry,
             element_dofs,
+            diagonal: Cell::new(None),
+            schur: None,
         })
+    }
+
+    /// Assembles `schur` with every Jacobian (mixed kernels only).
+    pub fn with_schur_preconditioner(mut self, schur: SchurPreconditioner<'a>) -> Self {
+        self.schur = Some(schur);
+        self
     }
 
     fn pressure_scale(&self) -> f64 {
@@ -153,7 +176,7 @@ impl<'a> StepProblem<'a> {
     }
 
     /// Collective. The local vector (owned and ghost dofs) of a global one.
-    pub fn local_values(&self, x: VecRef) -> Result<Vec<f64>, PetscError> {
+    pub fn local_values(&self, x: VecRef<'_>) -> Result<Vec<f64>, PetscError> {
         self.scatter.gather(x, |l| l.to_vec())
     }
 
@@ -228,14 +251,61 @@ impl<'a> StepProblem<'a> {
     }
 
     /// Collective: all ranks learn whether any element failed, so they fail together.
-    fn evaluate(&self, x: VecRef) -> Result<(Vec<f64>, Vec<ElementResult>), CallbackError> {
+    fn evaluate(&self, x: VecRef<'_>) -> Result<(Vec<f64>, Vec<ElementResult>), CallbackError> {
         let local = self
             .local_values(x)
             .map_err(|e| CallbackError::Fatal(e.to_string()))?;
         let elems = self.elements(&local);
         match agree_on_error(self.comm, elems.as_ref().err().cloned()) {
-            None => Ok((local, elems.map_err(CallbackError::Domain)?)),
+            None => {
+                let elems = elems.map_err(CallbackError::Domain)?;
+                if self.diagonal.get().is_none() {
+                    self.diagonal.set(Some(self.mean_free_diagonal(&elems)));
+                }
+                Ok((local, elems))
+            }
             Some(msg) => Err(CallbackError::Domain(msg)),
+        }
+    }
+
+    /// Collective. The mean diagonal of the free displacement rows of the tangent `elems`
+    /// (without contact and surface loads; 1 when no row is free).
+    fn mean_free_diagonal(&self, elems: &[ElementResult]) -> f64 {
+        let mut sums = [0.0; 2];
+        for (t, e) in elems.iter().enumerate() {
+            let n = e.residual.len();
+            for k in 0..12 {
+                if self.free_row(t, k).is_some() {
+                    sums[0] += e.tangent[k * n + k];
+                }
+            }
+        }
+        for n in 0..self.dofs.n_nodes() {
+            for c in 0..2 {
+                if self.free(n, c) {
+                    sums[1] += 1.0;
+                }
+            }
+        }
+        let sums = pfem_partition::sum_f64(self.comm, &sums);
+        let mean = sums[0] / sums[1].max(1.0);
+        if mean.is_finite() && mean > 0.0 {
+            mean
+        } else {
+            1.0
+        }
+    }
+
+    /// The diagonal of constrained rows, and the factor of their residual x − g.
+    fn constrained_diagonal(&self) -> f64 {
+        self.diagonal.get().unwrap_or(1.0)
+    }
+
+    /// Whether element dof `k` of triangle `t` is a prescribed displacement (owned or not).
+    fn constrained_column(&self, t: usize, k: usize) -> bool {
+        k < 12 && {
+            let node = self.dofs.tri_nodes[t][k / 2] as usize;
+            self.setup.constraints.fixed[node][k % 2].is_some()
         }
     }
 
@@ -389,15 +459,19 @@ impl StepProblem<'_> {
     fn external_tangent(
         &self,
         local: &[f64],
-        mut add: impl FnMut(i32, i32, f64) -> Result<(), PetscError>,
+        mut add: impl FnMut(Int, Int, f64) -> Result<(), PetscError>,
     ) -> Result<(), PetscError> {
-        let g = |n: usize, c: usize| (self.dofs.node_global[n] + c) as i32;
+        let g = |n: usize, c: usize| to_int(self.dofs.node_global[n] + c, "dof");
+        // A prescribed column adds an explicit zero: the matrix keeps one pattern, and the
+        // constrained rows and columns stay symmetric.
+        let fixed = |n: usize, k: usize| self.setup.constraints.fixed[n][k].is_some();
         for (c, f) in self.setup.contact.iter().zip(self.contact_forces(local)) {
             let n = c.node as usize;
             for i in 0..2 {
                 if self.free(n, i) {
                     for k in 0..2 {
-                        add(g(n, i), g(n, k), -f.tangent[i][k])?;
+                        let v = if fixed(n, k) { 0.0 } else { -f.tangent[i][k] };
+                        add(g(n, i)?, g(n, k)?, v)?;
                     }
                 }
             }
@@ -412,8 +486,12 @@ impl StepProblem<'_> {
                     }
                     for (b, &nb) in nodes.iter().enumerate() {
                         for k in 0..2 {
-                            let v = -load.tangent[2 * a + i][2 * b + k];
-                            add(g(na as usize, i), g(nb as usize, k), v)?;
+                            let v = if fixed(nb as usize, k) {
+                                0.0
+                            } else {
+                                -load.tangent[2 * a + i][2 * b + k]
+                            };
+                            add(g(na as usize, i)?, g(nb as usize, k)?, v)?;
                         }
                     }
                 }
@@ -424,9 +502,10 @@ impl StepProblem<'_> {
 }
 
 impl NonlinearProblem for StepProblem<'_> {
-    fn residual(&mut self, x: VecRef, f: VecRef) -> Result<(), CallbackError> {
+    fn residual(&mut self, x: VecRef<'_>, f: VecRef<'_>) -> Result<(), CallbackError> {
         let (local, elems) = self.evaluate(x)?;
         let first = self.dofs.first_dof;
+        let diagonal = self.constrained_diagonal();
         f.write(|fa| {
             fa.fill(0.0);
             for (t, e) in elems.iter().enumerate() {
@@ -456,7 +535,7 @@ impl NonlinearProblem for StepProblem<'_> {
                 for (c, g) in fx.iter().enumerate() {
                     if let Some(g) = g {
                         fa[self.dofs.node_global[n] - first + c] =
-                            local[self.dofs.node_local[n] + c] - g;
+                            diagonal * (local[self.dofs.node_local[n] + c] - g);
                     }
                 }
             }
@@ -464,25 +543,43 @@ impl NonlinearProblem for StepProblem<'_> {
         .map_err(|e| CallbackError::Fatal(e.to_string()))
     }
 
-    fn jacobian(&mut self, x: VecRef, j: MatRef) -> Result<(), CallbackError> {
+    fn jacobian(&mut self, x: VecRef<'_>, j: MatRef<'_>) -> Result<(), CallbackError> {
         let (local, elems) = self.evaluate(x)?;
         let fatal = |e: PetscError| CallbackError::Fatal(e.to_string());
-        let l2g = self.dofs.local_to_global();
+        let l2g = self
+            .dofs
+            .local_to_global()
+            .into_iter()
+            .map(|g| to_int(g, "dof"))
+            .collect::<Result<Vec<Int>, _>>()
+            .map_err(fatal)?;
         j.zero_entries().map_err(fatal)?;
         let mut rows = Vec::new();
         let mut vals = Vec::new();
         for (t, e) in elems.iter().enumerate() {
-            let cols: Vec<i32> = self.element_dofs[t]
-                .iter()
-                .map(|&d| l2g[d] as i32)
-                .collect();
+            let cols: Vec<Int> = self.element_dofs[t].iter().map(|&d| l2g[d]).collect();
             let n = cols.len();
             rows.clear();
             vals.clear();
             for (k, &col) in cols.iter().enumerate() {
                 if self.free_row(t, k).is_some() {
                     rows.push(col);
-                    vals.extend_from_slice(&e.tangent[k * n..(k + 1) * n]);
+                    // Prescribed columns are zeroed (not dropped, so the pattern stays): with
+                    // the constrained rows holding only their diagonal, the matrix stays as
+                    // symmetric as the tangent. Newton keeps prescribed dofs at their values,
+                    // so their columns would multiply a zero update anyway.
+                    vals.extend(
+                        e.tangent[k * n..(k + 1) * n]
+                            .iter()
+                            .enumerate()
+                            .map(|(c, &v)| {
+                                if self.constrained_column(t, c) {
+                                    0.0
+                                } else {
+                                    v
+                                }
+                            }),
+                    );
                 }
             }
             if !rows.is_empty() {
@@ -491,17 +588,71 @@ impl NonlinearProblem for StepProblem<'_> {
         }
         self.external_tangent(&local, |r, c, v| j.add_values(&[r], &[c], &[v]))
             .map_err(fatal)?;
+        let diagonal = self.constrained_diagonal();
         for (n, fx) in self.setup.constraints.fixed.iter().enumerate() {
             if !self.dofs.node_owned[n] {
                 continue;
             }
             for (c, g) in fx.iter().enumerate() {
                 if g.is_some() {
-                    let r = (self.dofs.node_global[n] + c) as i32;
-                    j.add_values(&[r], &[r], &[1.0]).map_err(fatal)?;
+                    let r = l2g[self.dofs.node_local[n] + c];
+                    j.add_values(&[r], &[r], &[diagonal]).map_err(fatal)?;
                 }
             }
         }
+        if let Some(schur) = &self.schur {
+            self.assemble_schur_preconditioner(schur, &local)
+                .map_err(fatal)?;
+        }
         j.assemble().map_err(fatal)
+    }
+}
+
+impl StepProblem<'_> {
+    /// Collective. The pressure mass matrix scaled by −(1/G_eff + 1/K) per triangle, in the
+    /// scaled pressure unknown: the Schur complement −(K_pp + B A⁻¹ Bᵀ) of a solid with shear
+    /// modulus G and bulk modulus K is spectrally close to it. G_eff is the current tangent's
+    /// (see [`super::split::effective_shear_modulus`]), so it follows plastic yielding.
+    fn assemble_schur_preconditioner(
+        &self,
+        schur: &SchurPreconditioner,
+        local: &[f64],
+    ) -> Result<(), PetscError> {
+        let Kernel::P2P1 { bulk, scale } = self.setup.kernel else {
+            return Ok(());
+        };
+        let m = schur.matrix.as_ref();
+        m.zero_entries()?;
+        for (t, nodes) in self.dofs.tri_nodes.iter().enumerate() {
+            let owned: Vec<usize> = (0..3)
+                .filter(|&a| self.dofs.node_owned[nodes[a] as usize])
+                .collect();
+            if owned.is_empty() {
+                continue;
+            }
+            let du: [[f64; 2]; 6] = std::array::from_fn(|k| self.node_u(local, nodes[k] as usize));
+            let x = &self.geometry[t];
+            let g = super::split::effective_shear_modulus(
+                x,
+                &du,
+                &self.setup.states_n[t],
+                self.setup.material,
+            )
+            .unwrap_or(f64::INFINITY);
+            let area = 0.5
+                * ((x[1][0] - x[0][0]) * (x[2][1] - x[0][1])
+                    - (x[1][1] - x[0][1]) * (x[2][0] - x[0][0]));
+            let factor = -scale * scale * (1.0 / g.max(f64::MIN_POSITIVE) + 1.0 / bulk);
+            let mass = super::split::p1_mass(area.abs());
+            let cols = nodes[..3]
+                .iter()
+                .map(|&n| to_int(schur.pressure_index[n as usize], "pressure"))
+                .collect::<Result<Vec<Int>, _>>()?;
+            for a in owned {
+                let vals: Vec<f64> = mass[a].iter().map(|v| factor * v).collect();
+                m.add_values(&cols[a..a + 1], &cols, &vals)?;
+            }
+        }
+        m.assemble()
     }
 }

@@ -1,0 +1,70 @@
+use super::error::{check, PetscError};
+use super::ffi;
+use super::matrix::to_int;
+use super::nullspace::NullSpace;
+use super::Int;
+use mpi::raw::AsRaw;
+use mpi::topology::SimpleCommunicator;
+
+/// A distributed list of global indices (a field of a block system); destroyed on drop.
+pub struct IndexSet {
+    pub(crate) raw: ffi::IS,
+}
+
+impl IndexSet {
+    /// Collective. This rank's `indices` (copied), grouped in blocks of `block` consecutive
+    /// indices (2: the two displacement components of a node).
+    pub fn general(
+        comm: &SimpleCommunicator,
+        indices: &[Int],
+        block: usize,
+    ) -> Result<IndexSet, PetscError> {
+        let mut raw: ffi::IS = std::ptr::null_mut();
+        // SAFETY: the index array is valid for its length and copied (PETSC_COPY_VALUES); the
+        // handle is owned by the returned value from the first successful call on.
+        unsafe {
+            check(
+                ffi::ISCreateGeneral(
+                    comm.as_raw(),
+                    to_int(indices.len(), "index set")?,
+                    indices.as_ptr(),
+                    ffi::PetscCopyMode_PETSC_COPY_VALUES,
+                    &mut raw,
+                ),
+                "ISCreateGeneral",
+            )?;
+            let is = IndexSet { raw };
+            check(
+                ffi::ISSetBlockSize(raw, to_int(block, "block size")?),
+                "ISSetBlockSize",
+            )?;
+            Ok(is)
+        }
+    }
+
+    /// Attaches the near-null space PCFIELDSPLIT hands to this field's diagonal block (it
+    /// queries the index set for "nearnullspace" when it extracts the block).
+    pub fn compose_near_null_space(&self, space: &NullSpace) -> Result<(), PetscError> {
+        let key = super::init::cstring("nearnullspace")?;
+        // SAFETY: both handles are live; PETSc takes its own reference to the null space.
+        check(
+            unsafe {
+                ffi::PetscObjectCompose(
+                    self.raw as ffi::PetscObject,
+                    key.as_ptr(),
+                    space.raw as ffi::PetscObject,
+                )
+            },
+            "PetscObjectCompose(nearnullspace)",
+        )
+    }
+}
+
+impl Drop for IndexSet {
+    fn drop(&mut self) {
+        // SAFETY: we own the handle.
+        unsafe {
+            ffi::ISDestroy(&mut self.raw);
+        }
+    }
+}

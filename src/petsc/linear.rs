@@ -1,0 +1,175 @@
+//! The linear solver inside Newton: a direct LU factorisation, or a Krylov method with algebraic
+//! multigrid (displacement problems) or with a Schur-complement field split (mixed u–p problems).
+//! Everything set here is a default: PETSc options on the command line override it, because
+//! `SNESSetFromOptions` runs after.
+
+use super::error::{check, PetscError};
+use super::ffi;
+use super::index_set::IndexSet;
+use super::init::cstring;
+use super::matrix::{to_int, Mat};
+use super::Scalar;
+
+/// How Newton's linear systems are solved.
+pub enum LinearSolver<'a> {
+    /// MUMPS LU: robust for any system, cost and memory superlinear in its size.
+    Direct,
+    /// Right-preconditioned GMRES with GAMG, for the displacement (P2) system: the matrix must
+    /// carry block size 2 and the rigid-body near-null space.
+    Amg { rtol: Scalar },
+    /// Right-preconditioned GMRES with an upper block-triangular Schur-complement field split,
+    /// for the mixed P2–P1 saddle point: GAMG on the displacement block (its index set carries
+    /// the rigid-body near-null space), and on the Schur complement `pressure_mass`, the
+    /// pressure mass matrix scaled by −1/G (spectrally equivalent to the Schur complement of
+    /// a nearly incompressible solid; a Jacobi sweep inverts it well enough).
+    Schur {
+        rtol: Scalar,
+        displacement: &'a IndexSet,
+        pressure: &'a IndexSet,
+        pressure_mass: &'a Mat,
+    },
+}
+
+/// Krylov iterations before a linear solve counts as failed (Newton then diverges and the
+/// step is cut).
+const MAX_LINEAR_IT: usize = 1000;
+/// GMRES restart: long enough that the AMG-preconditioned solves here do not restart.
+const RESTART: usize = 200;
+
+impl LinearSolver<'_> {
+    /// Collective. Configures `ksp` (borrowed from a SNES).
+    pub(crate) fn configure(&self, ksp: ffi::KSP) -> Result<(), PetscError> {
+        let mut pc: ffi::PC = std::ptr::null_mut();
+        // SAFETY: `ksp` is the live KSP of a SNES we own; the PC is borrowed from it. Index
+        // sets and matrices handed to the PC are referenced by PETSc, not taken over.
+        unsafe {
+            check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
+            match self {
+                LinearSolver::Direct => {
+                    set_ksp_type(ksp, "preonly")?;
+                    set_pc_type(pc, "lu")?;
+                    let mumps = cstring("mumps")?;
+                    check(
+                        ffi::PCFactorSetMatSolverType(pc, mumps.as_ptr()),
+                        "PCFactorSetMatSolverType",
+                    )?;
+                }
+                LinearSolver::Amg { rtol } => {
+                    krylov(ksp, *rtol)?;
+                    set_pc_type(pc, "gamg")?;
+                    // native-stack.md pitfall 4: reused GAMG interpolation once gave an
+                    // indefinite preconditioner on the second Newton iteration.
+                    check(
+                        ffi::PCGAMGSetReuseInterpolation(pc, ffi::PetscBool_PETSC_FALSE),
+                        "PCGAMGSetReuseInterpolation",
+                    )?;
+                }
+                LinearSolver::Schur {
+                    rtol,
+                    displacement,
+                    pressure,
+                    pressure_mass,
+                } => {
+                    krylov(ksp, *rtol)?;
+                    set_pc_type(pc, "fieldsplit")?;
+                    let (u, p) = (cstring("u")?, cstring("p")?);
+                    check(
+                        ffi::PCFieldSplitSetIS(pc, u.as_ptr(), displacement.raw),
+                        "PCFieldSplitSetIS(u)",
+                    )?;
+                    check(
+                        ffi::PCFieldSplitSetIS(pc, p.as_ptr(), pressure.raw),
+                        "PCFieldSplitSetIS(p)",
+                    )?;
+                    check(
+                        ffi::PCFieldSplitSetType(pc, ffi::PCCompositeType_PC_COMPOSITE_SCHUR),
+                        "PCFieldSplitSetType",
+                    )?;
+                    check(
+                        ffi::PCFieldSplitSetSchurFactType(
+                            pc,
+                            ffi::PCFieldSplitSchurFactType_PC_FIELDSPLIT_SCHUR_FACT_UPPER,
+                        ),
+                        "PCFieldSplitSetSchurFactType",
+                    )?;
+                    check(
+                        ffi::PCFieldSplitSetSchurPre(
+                            pc,
+                            ffi::PCFieldSplitSchurPreType_PC_FIELDSPLIT_SCHUR_PRE_USER,
+                            pressure_mass.raw,
+                        ),
+                        "PCFieldSplitSetSchurPre",
+                    )?;
+                    // The split's inner solvers exist only once the PC is set up, so their
+                    // defaults go to the options database, where the command line wins.
+                    for (name, value) in [
+                        ("-fieldsplit_u_ksp_type", "preonly"),
+                        ("-fieldsplit_u_pc_type", "gamg"),
+                        ("-fieldsplit_u_pc_gamg_reuse_interpolation", "false"),
+                        ("-fieldsplit_p_ksp_type", "preonly"),
+                        ("-fieldsplit_p_pc_type", "jacobi"),
+                    ] {
+                        default_option(name, value)?;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// GMRES with right preconditioning, so that the tolerance applies to the true residual.
+unsafe fn krylov(ksp: ffi::KSP, rtol: Scalar) -> Result<(), PetscError> {
+    set_ksp_type(ksp, "gmres")?;
+    check(
+        ffi::KSPGMRESSetRestart(ksp, to_int(RESTART, "GMRES restart")?),
+        "KSPGMRESSetRestart",
+    )?;
+    check(ffi::KSPSetPCSide(ksp, ffi::PCSide_PC_RIGHT), "KSPSetPCSide")?;
+    check(
+        ffi::KSPSetTolerances(
+            ksp,
+            rtol,
+            1e-50,
+            ffi::PETSC_DEFAULT as Scalar,
+            to_int(MAX_LINEAR_IT, "KSP iterations")?,
+        ),
+        "KSPSetTolerances",
+    )
+}
+
+unsafe fn set_ksp_type(ksp: ffi::KSP, kind: &str) -> Result<(), PetscError> {
+    let kind = cstring(kind)?;
+    check(ffi::KSPSetType(ksp, kind.as_ptr()), "KSPSetType")
+}
+
+unsafe fn set_pc_type(pc: ffi::PC, kind: &str) -> Result<(), PetscError> {
+    let kind = cstring(kind)?;
+    check(ffi::PCSetType(pc, kind.as_ptr()), "PCSetType")
+}
+
+/// Puts `name value` into PETSc's options database unless the command line gave `name`.
+fn default_option(name: &str, value: &str) -> Result<(), PetscError> {
+    let (n, v) = (cstring(name)?, cstring(value)?);
+    let mut given = ffi::PetscBool_PETSC_FALSE;
+    // SAFETY: nul-terminated strings; the global options database (null) is live between
+    // PetscInitialize and PetscFinalize.
+    unsafe {
+        check(
+            ffi::PetscOptionsHasName(
+                std::ptr::null_mut(),
+                std::ptr::null(),
+                n.as_ptr(),
+                &mut given,
+            ),
+            "PetscOptionsHasName",
+        )?;
+        if given == ffi::PetscBool_PETSC_FALSE {
+            check(
+                ffi::PetscOptionsSetValue(std::ptr::null_mut(), n.as_ptr(), v.as_ptr()),
+                "PetscOptionsSetValue",
+            )?;
+        }
+    }
+    Ok(())
+}

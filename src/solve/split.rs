@@ -1,0 +1,169 @@
+//! The two fields of the mixed P2–P1 system for a Schur-complement preconditioner: which global
+//! dofs are displacements and which pressures, the pressures' own numbering (the layout of the
+//! Schur complement), and the pressure mass matrix scaled by the inverse shear modulus that
+//! stands in for the Schur complement.
+
+use super::DofMap;
+use crate::fem::element::displacement_gradient;
+use crate::fem::mixed::log_strain;
+use crate::fem::p2::physical_gradients;
+use crate::fem::quadrature::{area_to_reference, TRI3_POINTS};
+use crate::material::{GaussState, Material};
+use mpi::traits::Communicator;
+use pfem_partition::{exscan_u64, sum_f64, Comm};
+
+/// The owned dofs of each field and the pressure numbering.
+pub struct FieldLayout {
+    /// Global dofs of this rank's displacement unknowns, node by node (ux, uy).
+    pub displacement: Vec<usize>,
+    /// Global dofs of this rank's pressure unknowns.
+    pub pressure: Vec<usize>,
+    /// Per local node: its pressure's index in the pressure-only numbering (`usize::MAX` for a
+    /// midside node).
+    pub pressure_index: Vec<usize>,
+    /// Nonzeros per owned pressure row of the P1 mass matrix, in and out of the diagonal block.
+    pub mass_d_nnz: Vec<usize>,
+    pub mass_o_nnz: Vec<usize>,
+}
+
+impl FieldLayout {
+    /// Collective. The layout of a mixed `dofs` (vertex nodes carry ux, uy, p).
+    pub fn new(comm: &Comm, dofs: &DofMap) -> FieldLayout {
+        assert_eq!(dofs.vertex_dofs, 3, "a field split needs pressure unknowns");
+        let n_vertex = dofs.n_nodes() - dofs.edges.len();
+        let mut displacement = Vec::new();
+        let mut pressure = Vec::new();
+        for n in 0..dofs.n_nodes() {
+            if dofs.node_owned[n] {
+                let g = dofs.node_global[n];
+                displacement.extend([g, g + 1]);
+                if n < n_vertex {
+                    pressure.push(g + 2);
+                }
+            }
+        }
+        // A rank numbers its owned vertex nodes first (3 dofs each), so an owned vertex's
+        // position among them is (g - first_dof) / 3 on its owner: with every rank's first
+        // dof and first pressure, any rank numbers any vertex's pressure by itself.
+        let (first_p, _) = exscan_u64(comm, pressure.len() as u64);
+        let size = comm.size() as usize;
+        let mut slots = vec![0.0; 2 * size];
+        slots[2 * comm.rank() as usize] = dofs.first_dof as f64;
+        slots[2 * comm.rank() as usize + 1] = first_p as f64;
+        let firsts = sum_f64(comm, &slots);
+        let first_dof: Vec<usize> = (0..size).map(|r| firsts[2 * r] as usize).collect();
+        let first_pressure: Vec<usize> = (0..size).map(|r| firsts[2 * r + 1] as usize).collect();
+        let pressure_index = (0..dofs.n_nodes())
+            .map(|n| {
+                if n >= n_vertex {
+                    return usize::MAX;
+                }
+                let g = dofs.node_global[n];
+                // The owner: the last rank whose first dof is at or below g (ranks without
+                // dofs share their successor's first dof and come before it).
+                let r = first_dof.partition_point(|&f| f <= g) - 1;
+                first_pressure[r] + (g - first_dof[r]) / 3
+            })
+            .collect();
+        let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n_vertex];
+        for nodes in &dofs.tri_nodes {
+            for &a in &nodes[..3] {
+                if dofs.node_owned[a as usize] {
+                    neighbours[a as usize].extend_from_slice(&nodes[..3]);
+                }
+            }
+        }
+        let mut mass_d_nnz = Vec::with_capacity(pressure.len());
+        let mut mass_o_nnz = Vec::with_capacity(pressure.len());
+        for (a, nb) in neighbours.iter_mut().enumerate() {
+            if !dofs.node_owned[a] {
+                continue;
+            }
+            nb.sort_unstable();
+            nb.dedup();
+            let owned = nb.iter().filter(|&&b| dofs.node_owned[b as usize]).count();
+            mass_d_nnz.push(owned);
+            mass_o_nnz.push(nb.len() - owned);
+        }
+        FieldLayout {
+            displacement,
+            pressure,
+            pressure_index,
+            mass_d_nnz,
+            mass_o_nnz,
+        }
+    }
+}
+
+/// The P1 mass matrix of a triangle of area `area`: ∫ L_i L_j = area (1 + δ_ij) / 12.
+pub fn p1_mass(area: f64) -> [[f64; 3]; 3] {
+    std::array::from_fn(|i| std::array::from_fn(|j| area * if i == j { 2.0 } else { 1.0 } / 12.0))
+}
+
+/// The shear stiffness of the material's tangent over a triangle at the step displacement
+/// `du`: at each Gauss point the mean of the tangent's stiffness against the two in-plane
+/// deviatoric strains (a stretch and a shear), averaged over the points. It is G for an
+/// elastic tangent and G/2 for a perfectly plastic one at yield (one deviatoric direction has
+/// lost its stiffness), so the Schur preconditioner follows the tangent without dividing by zero.
+/// `None` when the triangle is inverted or degenerate at `du`.
+pub fn effective_shear_modulus(
+    x: &[[f64; 2]; 6],
+    du: &[[f64; 2]; 6],
+    states_n: &[GaussState; 3],
+    material: &dyn Material,
+) -> Option<f64> {
+    let mut sum = 0.0;
+    for (q, l) in TRI3_POINTS.iter().enumerate() {
+        let pg = physical_gradients(x, area_to_reference(*l)).ok()?;
+        let h = displacement_gradient(&pg.grad, du);
+        let eps = log_strain(&h)?;
+        let d = material.update_log_strain(&states_n[q], &eps).ok()?.d;
+        // Stretch (1, -1)/√2: ε·Dε = 2G; engineering shear γ = 1: ε·Dε = G.
+        let stretch = 0.25 * (d[0][0] - d[0][1] - d[1][0] + d[1][1]);
+        let shear = d[3][3];
+        sum += 0.5 * (stretch + shear);
+    }
+    Some(sum / TRI3_POINTS.len() as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::elastic::LinearElastic;
+    use crate::material::tresca::Tresca;
+
+    fn triangle() -> [[f64; 2]; 6] {
+        crate::fem::p2::straight_sided(&[[0.0, 0.0], [1.0, 0.1], [0.2, 0.9]])
+    }
+
+    #[test]
+    fn effective_shear_is_g_for_an_elastic_tangent() {
+        let (e, nu) = (12.0e6, 0.3);
+        let g = e / (2.0 * (1.0 + nu));
+        let mat = LinearElastic::new(e, nu).expect("material");
+        let states = [GaussState::default(); 3];
+        let du = [[0.001, -0.002]; 6];
+        let got = effective_shear_modulus(&triangle(), &du, &states, &mat).expect("valid");
+        assert!((got - g).abs() < 1e-9 * g, "{got} vs {g}");
+    }
+
+    #[test]
+    fn effective_shear_drops_to_half_at_yield() {
+        let (e, nu, cu) = (10.0e6, 0.49, 10.0e3);
+        let g = e / (2.0 * (1.0 + nu));
+        let mat = Tresca::new(e, nu, cu).expect("material");
+        let states = [GaussState::default(); 3];
+        // A simple shear well past yield: γ = 0.01 ≫ cu/G.
+        let x = triangle();
+        let du: [[f64; 2]; 6] = std::array::from_fn(|k| [0.01 * x[k][1], 0.0]);
+        let got = effective_shear_modulus(&x, &du, &states, &mat).expect("valid");
+        assert!((got - 0.5 * g).abs() < 1e-6 * g, "{got} vs {}", 0.5 * g);
+    }
+
+    #[test]
+    fn p1_mass_sums_to_the_area() {
+        let m = p1_mass(0.3);
+        let total: f64 = m.iter().flatten().sum();
+        assert!((total - 0.3).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,315 @@
+//! The iterative linear path (GMRES with GAMG and the rigid-body near-null space for P2, a
+//! Schur-complement field split for P2–P1) against the direct one: same Newton histories, a
+//! linear iteration count that does not grow with refinement, convergence for a nearly
+//! incompressible solid, and the rigid-body modes in the kernel of the stiffness.
+
+mod common;
+
+use common::{history, ok, workdir};
+use pfem_mpi::fem::element::p2_element;
+use pfem_mpi::fem::mixed::p2p1_element;
+use pfem_mpi::fem::p2::straight_sided;
+use pfem_mpi::material::elastic::LinearElastic;
+use pfem_mpi::material::GaussState;
+use pfem_mpi::solve::nullspace::rigid_body_modes;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Largest relative difference between two histories (same columns and rows).
+fn max_relative_difference(a: &Path, b: &Path) -> f64 {
+    let (ha, ra) = history(a);
+    let (hb, rb) = history(b);
+    assert_eq!(ha, hb, "history columns");
+    assert_eq!(ra.len(), rb.len(), "history rows");
+    let mut worst: f64 = 0.0;
+    for (x, y) in ra.iter().zip(&rb) {
+        for (u, v) in x.iter().zip(y) {
+            let scale = u.abs().max(v.abs());
+            if scale > 0.0 {
+                worst = worst.max((u - v).abs() / scale);
+            }
+        }
+    }
+    worst
+}
+
+/// (Newton iterations, linear iterations) from the end-of-run line.
+fn iterations(stdout: &str) -> (usize, usize) {
+    let done = stdout
+        .lines()
+        .find(|l| l.starts_with("done:"))
+        .unwrap_or_else(|| panic!("no end-of-run line in\n{stdout}"));
+    let count = |what: &str| -> usize {
+        let words: Vec<&str> = done.split([' ', ',']).filter(|w| !w.is_empty()).collect();
+        let at = words
+            .iter()
+            .position(|w| *w == what)
+            .unwrap_or_else(|| panic!("no '{what}' in {done}"));
+        words[at - 1].parse().expect("a count")
+    };
+    (count("Newton"), count("linear"))
+}
+
+/// Writes `case` (scene `scene` with `sets`), runs it with the direct and the iterative
+/// solver on `ranks` ranks for `steps` steps, and returns the histories' largest relative
+/// difference and the iterative run's (Newton, linear) iterations.
+fn direct_against_iterative(
+    dir: &Path,
+    scene: &str,
+    sets: &[&str],
+    ranks: usize,
+    steps: u32,
+) -> (f64, (usize, usize)) {
+    let until = steps.to_string();
+    let mut outs = Vec::new();
+    for linear in ["direct", "iterative"] {
+        let case = format!("{linear}.h5");
+        let choice = format!("solver.linear=\"{linear}\"");
+        let mut args = vec!["new", scene, "-o", &case, "--set", &choice];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        ok(dir, 1, &args);
+        let out = format!("{linear}{ranks}");
+        let stdout = ok(dir, ranks, &[&case, "--out", &out, "--until-step", &until]);
+        outs.push((out, stdout));
+    }
+    let diff = max_relative_difference(
+        &dir.join(&outs[0].0).join("history.csv"),
+        &dir.join(&outs[1].0).join("history.csv"),
+    );
+    (diff, iterations(&outs[1].1))
+}
+
+#[test]
+fn iterative_cantilever_matches_the_direct_history_on_1_and_2_ranks() {
+    let dir = workdir("iterative-cantilever");
+    for ranks in [1, 2] {
+        let (diff, (newton, linear)) = direct_against_iterative(
+            &dir,
+            "cantilever",
+            &["mesh.h=0.25", "steps.count=10"],
+            ranks,
+            3,
+        );
+        println!("cantilever, {ranks} ranks: max relative difference {diff:.2e}, {newton} Newton and {linear} linear iterations");
+        assert!(diff < 1e-6, "{ranks} ranks: {diff:e}");
+        assert!(
+            linear > newton,
+            "the iterative path ran: {linear} linear iterations"
+        );
+    }
+}
+
+#[test]
+fn iterative_footing_shallow_matches_the_direct_history_on_1_and_2_ranks() {
+    let dir = workdir("iterative-footing");
+    for ranks in [1, 2] {
+        let (diff, (newton, linear)) = direct_against_iterative(
+            &dir,
+            "footing-shallow",
+            &[
+                "mesh.h=0.5",
+                "mesh.fine=[{origin=[0.0,8.0],size=[4.0,2.0],h=0.25},\
+                 {origin=[0.5,9.5],size=[1.0,0.5],h=0.125}]",
+            ],
+            ranks,
+            3,
+        );
+        println!("footing-shallow, {ranks} ranks: max relative difference {diff:.2e}, {newton} Newton and {linear} linear iterations");
+        assert!(diff < 1e-6, "{ranks} ranks: {diff:e}");
+        assert!(
+            linear > newton,
+            "the iterative path ran: {linear} linear iterations"
+        );
+    }
+}
+
+#[test]
+fn linear_iterations_per_newton_iteration_barely_grow_with_refinement() {
+    let dir = workdir("iterative-refinement");
+    let mut per_newton = Vec::new();
+    for h in ["0.25", "0.125"] {
+        let spacing = format!("mesh.h={h}");
+        let case = format!("c{h}.h5");
+        ok(
+            &dir,
+            1,
+            &[
+                "new",
+                "cantilever",
+                "-o",
+                &case,
+                "--set",
+                &spacing,
+                "--set",
+                "steps.count=10",
+                "--set",
+                "solver.linear=\"iterative\"",
+            ],
+        );
+        let out = format!("out{h}");
+        let stdout = ok(&dir, 1, &[&case, "--out", &out, "--until-step", "2"]);
+        let (newton, linear) = iterations(&stdout);
+        let mean = linear as f64 / newton as f64;
+        println!("h = {h}: {newton} Newton iterations, {linear} linear iterations, {mean:.1} per Newton iteration");
+        per_newton.push(mean);
+    }
+    let growth = per_newton[1] / per_newton[0];
+    assert!(
+        (growth - 1.0).abs() < 0.3,
+        "linear iterations per Newton iteration {per_newton:?}: ratio {growth:.2}"
+    );
+}
+
+#[test]
+fn nearly_incompressible_elastic_block_converges_with_the_field_split() {
+    let dir = workdir("iterative-incompressible");
+    let (diff, (newton, linear)) = direct_against_iterative(
+        &dir,
+        "block-compression",
+        &[
+            "material={model=\"linear-elastic\",young=3.0e6,poisson=0.4999,density=0.0}",
+            "solver.element=\"p2p1\"",
+            "mesh.h=0.1",
+            "steps.count=20",
+        ],
+        1,
+        3,
+    );
+    println!("block, nu = 0.4999: max relative difference {diff:.2e}, {newton} Newton and {linear} linear iterations");
+    assert!(diff < 1e-6, "{diff:e}");
+    // Measured 41.5 per Newton iteration at h = 0.1 and 45.9 at h = 0.05.
+    assert!(
+        linear <= 80 * newton,
+        "{linear} linear iterations for {newton} Newton iterations"
+    );
+}
+
+/// A P2 mesh of a distorted 3 x 2 patch of squares cut into triangles: node coordinates
+/// (vertices, then midside nodes) and the 6 nodes of every triangle.
+fn patch() -> (Vec<[f64; 2]>, Vec<[usize; 6]>) {
+    let (nx, ny) = (3, 2);
+    let mut coords = Vec::new();
+    for j in 0..=ny {
+        for i in 0..=nx {
+            // A shear and a bulge, so that no element is a scaled copy of another.
+            let (x, y) = (i as f64, j as f64);
+            coords.push([0.7 * x + 0.2 * y + 0.05 * (x * y), 0.5 * y + 0.03 * x * x]);
+        }
+    }
+    let v = |i: usize, j: usize| j * (nx + 1) + i;
+    let mut tris = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            tris.push([v(i, j), v(i + 1, j), v(i + 1, j + 1)]);
+            tris.push([v(i, j), v(i + 1, j + 1), v(i, j + 1)]);
+        }
+    }
+    let mut edges: HashMap<(usize, usize), usize> = HashMap::new();
+    let mut out = Vec::new();
+    for t in &tris {
+        let mut nodes = [t[0], t[1], t[2], 0, 0, 0];
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let next = coords.len();
+            let m = *edges.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let (pa, pb) = (coords[a], coords[b]);
+                coords.push([0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1])]);
+                next
+            });
+            nodes[3 + k] = m;
+        }
+        out.push(nodes);
+    }
+    (coords, out)
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// ‖K r‖ / (‖K‖_F ‖r‖) for each vector r of `modes(coords)` (zero on pressure dofs), K the
+/// unconstrained patch matrix assembled from `element` (row-major, the 12 displacement dofs
+/// first, then `extra` dofs per vertex).
+fn kernel_residuals(
+    extra: usize,
+    element: impl Fn(&[[f64; 2]; 6]) -> Vec<f64>,
+    modes: impl Fn(&[[f64; 2]]) -> Vec<Vec<f64>>,
+) -> Vec<f64> {
+    let (coords, tris) = patch();
+    let n_vertex = 12;
+    let n_u = 2 * coords.len();
+    let n = n_u + extra * n_vertex;
+    let mut k = vec![0.0; n * n];
+    for t in &tris {
+        let ke = element(&straight_sided(&[coords[t[0]], coords[t[1]], coords[t[2]]]));
+        let mut dofs: Vec<usize> = t.iter().flat_map(|&a| [2 * a, 2 * a + 1]).collect();
+        if extra > 0 {
+            dofs.extend(t[..3].iter().map(|&a| n_u + a));
+        }
+        let m = dofs.len();
+        for (r, &gr) in dofs.iter().enumerate() {
+            for (c, &gc) in dofs.iter().enumerate() {
+                k[gr * n + gc] += ke[r * m + c];
+            }
+        }
+    }
+    let k_norm = norm(&k);
+    modes(&coords)
+        .into_iter()
+        .map(|mut r| {
+            r.resize(n, 0.0);
+            let kr: Vec<f64> = (0..n)
+                .map(|i| (0..n).map(|j| k[i * n + j] * r[j]).sum())
+                .collect();
+            norm(&kr) / (k_norm * norm(&r))
+        })
+        .collect()
+}
+
+fn rigid(coords: &[[f64; 2]]) -> Vec<Vec<f64>> {
+    rigid_body_modes(coords, [0.9, 0.6]).to_vec()
+}
+
+#[test]
+fn rigid_body_modes_are_in_the_kernel_of_the_stress_free_tangents() {
+    let states = [GaussState::default(); 3];
+    let mat = LinearElastic::new(12.0e6, 0.3).expect("material");
+    let p2 = kernel_residuals(
+        0,
+        |x| {
+            let e = p2_element(x, &[[0.0; 2]; 6], &states, &mat, [0.0; 2]).expect("element");
+            e.tangent.as_flattened().to_vec()
+        },
+        rigid,
+    );
+    // ν = 0.4999: the displacement and pressure blocks of a nearly incompressible solid.
+    let nu = 0.4999;
+    let soft = LinearElastic::new(12.0e6, nu).expect("material");
+    let bulk = 12.0e6 / (3.0 * (1.0 - 2.0 * nu));
+    let mixed = kernel_residuals(
+        1,
+        |x| {
+            let e = p2p1_element(x, &[[0.0; 2]; 6], &[0.0; 3], &states, &soft, bulk, [0.0; 2])
+                .expect("element")
+                .with_pressure_scale(4.0e6);
+            e.tangent.as_flattened().to_vec()
+        },
+        rigid,
+    );
+    println!("|K r| / (|K| |r|): P2 {p2:?}, P2-P1 {mixed:?}");
+    for r in p2.iter().chain(&mixed) {
+        assert!(*r < 1e-14, "a rigid-body mode is not in the kernel: {r:e}");
+    }
+    // The check can fail: a stretch is no rigid-body mode.
+    let stretch = kernel_residuals(
+        0,
+        |x| {
+            let e = p2_element(x, &[[0.0; 2]; 6], &states, &mat, [0.0; 2]).expect("element");
+            e.tangent.as_flattened().to_vec()
+        },
+        |c| vec![c.iter().flat_map(|x| [x[0], 0.0]).collect()],
+    );
+    assert!(stretch[0] > 1e-3, "a stretch in the kernel: {stretch:?}");
+}
