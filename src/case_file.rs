@@ -22,9 +22,18 @@
 //! start), `h` (f64, n), `state` (f64, n x 9), `flags` (u32, n), `increment` (f64, n x 2, the
 //! last step's displacement increment).
 //!
+//! Group `/gauss` (checkpoints): see `case_file/gauss.rs`. Every dataset carries an attribute
+//! `checksum` (u64, `case_file/checksum.rs`), checked on reading; files written before it have
+//! none and are read unchecked (no version change: older programs ignore the attribute).
+//!
 //! The file is written collectively by all ranks (each writes its own rows, placed by rank
-//! order) and can be read back by any number of ranks, each getting a contiguous block.
+//! order) and can be read back by any number of ranks, each getting a contiguous block. Besides
+//! types and shapes, what is read must satisfy the rules of `case_file/validate.rs` (the scene's
+//! own, and the format's invariants); a file that breaks one is an error naming the dataset or
+//! attribute, in runs and in `pfem-mpi info`.
 
+#[path = "case_file/checksum.rs"]
+mod checksum;
 #[path = "case_file/collective.rs"]
 mod collective;
 #[path = "case_file/datasets.rs"]
@@ -64,6 +73,7 @@ pub use gauss::{GaussRecords, CONTACT_LEN, GAUSS_LEN, NODE_LEN};
 pub use particles::{ParticleSet, STATE_LEN};
 
 use crate::scene::{generate_particles, lattice, Scene};
+use checksum::Word;
 use collective::agree;
 use datasets::Column;
 pub(crate) use lockstep::{estimate as estimate_bytes, write_hdf5, Lockstep};
@@ -202,7 +212,7 @@ fn write_column<T: H5Type>(
     n: usize,
     rows: Range<usize>,
     data: &[T],
-) -> hdf5::Result<()> {
+) -> hdf5::Result<Dataset> {
     let ds = datasets::create::<T>(group, c, n)?;
     let space = ds.space()?;
     let selected = if c.width == 0 {
@@ -210,7 +220,23 @@ fn write_column<T: H5Type>(
     } else {
         space.select((rows, ..))?
     };
-    ffi::write_collective(&ds, &selected, data)
+    ffi::write_collective(&ds, &selected, data)?;
+    Ok(ds)
+}
+
+/// Collective. Column `c` and its checksum, each an agreed step.
+fn column_step<T: H5Type + Word>(
+    step: &Lockstep<'_>,
+    group: &Group,
+    c: &Column,
+    n: usize,
+    rows: Range<usize>,
+    data: &[T],
+) -> Result<(), CaseError> {
+    let what = format!("dataset /{}/{}", datasets::GROUP, c.name);
+    let ds = step.step(&what, write_column(group, c, n, rows.clone(), data))?;
+    let sum = step.total(checksum::rows_sum(rows.start, c.width, data));
+    step.step(&what, checksum::put(&ds, sum))
 }
 
 /// Reads rows `rows` of `ds` into `out` (collective).
@@ -246,48 +272,29 @@ fn write_contents(
     gauss::write(file, step, gauss, gauss_rows.0, gauss_rows.1)?;
     let group = step.step("group /particles", file.create_group(datasets::GROUP))?;
     let [gid, position, displacement, h, state, flags, increment] = datasets::columns();
-    let column =
-        |c: &Column, r: hdf5::Result<()>| step.step(&format!("dataset /particles/{}", c.name), r);
-    column(
-        &gid,
-        write_column(&group, &gid, n, rows.clone(), &local.gid),
-    )?;
-    column(
+    let (g, r) = (&group, rows);
+    column_step(step, g, &gid, n, r.clone(), &local.gid)?;
+    column_step(
+        step,
+        g,
         &increment,
-        write_column(
-            &group,
-            &increment,
-            n,
-            rows.clone(),
-            local.increment.as_flattened(),
-        ),
+        n,
+        r.clone(),
+        local.increment.as_flattened(),
     )?;
-    column(
+    column_step(
+        step,
+        g,
         &position,
-        write_column(
-            &group,
-            &position,
-            n,
-            rows.clone(),
-            local.position.as_flattened(),
-        ),
+        n,
+        r.clone(),
+        local.position.as_flattened(),
     )?;
-    column(
-        &displacement,
-        write_column(
-            &group,
-            &displacement,
-            n,
-            rows.clone(),
-            local.displacement.as_flattened(),
-        ),
-    )?;
-    column(&h, write_column(&group, &h, n, rows.clone(), &local.h))?;
-    column(
-        &state,
-        write_column(&group, &state, n, rows.clone(), local.state.as_flattened()),
-    )?;
-    column(&flags, write_column(&group, &flags, n, rows, &local.flags))
+    let displacements = local.displacement.as_flattened();
+    column_step(step, g, &displacement, n, r.clone(), displacements)?;
+    column_step(step, g, &h, n, r.clone(), &local.h)?;
+    column_step(step, g, &state, n, r.clone(), local.state.as_flattened())?;
+    column_step(step, g, &flags, n, r, &local.flags)
 }
 
 /// Collective. Writes a case file: every rank passes its own particles (any count, zero
@@ -444,6 +451,38 @@ fn read_contents(comm: &SimpleCommunicator, file: &File, path: &Path) -> Result<
         )
     });
     agree(comm, path, read)?;
+    let first = block.start as usize;
+    let sums = [
+        (&gid, checksum::verify(comm, &ds[0], first, 0, &p.gid)),
+        (
+            &position,
+            checksum::verify(comm, &ds[1], first, 2, p.position.as_flattened()),
+        ),
+        (
+            &displacement,
+            checksum::verify(comm, &ds[2], first, 2, p.displacement.as_flattened()),
+        ),
+        (&h, checksum::verify(comm, &ds[3], first, 0, &p.h)),
+        (
+            &state,
+            checksum::verify(comm, &ds[4], first, STATE_LEN, p.state.as_flattened()),
+        ),
+        (&flags, checksum::verify(comm, &ds[5], first, 0, &p.flags)),
+        (
+            &increment,
+            checksum::verify(comm, &ds[6], first, 2, p.increment.as_flattened()),
+        ),
+    ];
+    // Every rank has the same outcomes (each checksum is a total over all ranks).
+    for (c, outcome) in sums {
+        outcome.map_err(|m| {
+            CaseError::new(path, CaseErrorKind::Malformed, m).at(format!(
+                "dataset /{}/{}",
+                datasets::GROUP,
+                c.name
+            ))
+        })?;
+    }
     Ok((header, p, block.start as usize, n))
 }
 
@@ -468,10 +507,18 @@ pub fn read_checkpoint(
     let (header, particles, first, n) = read_block(comm, path)?;
     let opened = mpio_file(comm, path, false).map_err(|e| open_error(path, e));
     let file = agree(comm, path, opened)?;
-    let records = gauss::read(comm, &file, path);
+    let records = agree(comm, path, gauss::read(comm, &file, path));
+    let verified = match &records {
+        Ok(g) => {
+            let (first, _) = pfem_partition::exscan_u64(comm, g.len() as u64);
+            gauss::verify(comm, &file, path, g, first as usize)
+        }
+        Err(_) => Ok(()),
+    };
     let closed = file
         .close()
         .map_err(|e| CaseError::new(path, CaseErrorKind::Io, format!("cannot close: {e}")));
+    let records = records.and_then(|g| verified.map(|_| g));
     let records = agree(comm, path, records.and_then(|g| closed.map(|_| g)))?;
     validate_blocks::validate_blocks(comm, path, &header, &particles, first, n, &records)?;
     Ok((header, particles, records))

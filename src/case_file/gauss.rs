@@ -6,10 +6,11 @@
 use std::ops::Range;
 use std::path::Path;
 
-use hdf5::{File, H5Type};
+use hdf5::{Dataset, File, H5Type};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
 
+use super::checksum::{self, Word};
 use super::collective::block_range;
 use super::error::{CaseError, CaseErrorKind};
 use super::ffi;
@@ -53,14 +54,30 @@ fn column<T: H5Type>(
     n: usize,
     rows: Range<usize>,
     data: &[T],
-) -> hdf5::Result<()> {
+) -> hdf5::Result<Dataset> {
     let group = match file.group(GROUP) {
         Ok(g) => g,
         Err(_) => file.create_group(GROUP)?,
     };
     let ds = group.new_dataset::<T>().shape((n, width)).create(name)?;
     let selected = ds.space()?.select((rows, ..))?;
-    ffi::write_collective(&ds, &selected, data)
+    ffi::write_collective(&ds, &selected, data)?;
+    Ok(ds)
+}
+
+/// Collective. Dataset `name` and its checksum, each an agreed step.
+fn column_step<T: H5Type + Word>(
+    step: &Lockstep<'_>,
+    file: &File,
+    name: &str,
+    width: usize,
+    (n, rows): (usize, Range<usize>),
+    data: &[T],
+) -> Result<(), CaseError> {
+    let what = format!("dataset /{GROUP}/{name}");
+    let ds = step.step(&what, column(file, name, width, n, rows.clone(), data))?;
+    let sum = step.total(checksum::rows_sum(rows.start, width, data));
+    step.step(&what, checksum::put(&ds, sum))
 }
 
 /// Collective: every rank writes its rows `rows` of `n`, one agreed step per dataset.
@@ -71,37 +88,18 @@ pub(crate) fn write(
     rows: Range<usize>,
     n: usize,
 ) -> Result<(), CaseError> {
-    let each = |name: &str, r: hdf5::Result<()>| step.step(&format!("dataset /{GROUP}/{name}"), r);
-    each(
-        "key",
-        column(file, "key", 3, n, rows.clone(), g.key.as_flattened()),
-    )?;
-    each(
-        "nodes",
-        column(
-            file,
-            "nodes",
-            NODE_LEN,
-            n,
-            rows.clone(),
-            g.nodes.as_flattened(),
-        ),
-    )?;
-    each(
+    let at = || (n, rows.clone());
+    column_step(step, file, "key", 3, at(), g.key.as_flattened())?;
+    column_step(step, file, "nodes", NODE_LEN, at(), g.nodes.as_flattened())?;
+    column_step(
+        step,
+        file,
         "contact",
-        column(
-            file,
-            "contact",
-            CONTACT_LEN,
-            n,
-            rows.clone(),
-            g.contact.as_flattened(),
-        ),
+        CONTACT_LEN,
+        at(),
+        g.contact.as_flattened(),
     )?;
-    each(
-        "state",
-        column(file, "state", GAUSS_LEN, n, rows, g.state.as_flattened()),
-    )
+    column_step(step, file, "state", GAUSS_LEN, at(), g.state.as_flattened())
 }
 
 /// Collective: a contiguous block of the records per rank (all empty when the group is absent).
@@ -186,4 +184,32 @@ pub fn read(
     })();
     read.map_err(|e| bad("state", format!("cannot read: {e}")))?;
     Ok(g)
+}
+
+/// Collective. Checks the checksums of the records this rank read, rows `first..` (every rank
+/// gets the same outcome: each checksum is a total over all ranks).
+pub fn verify(
+    comm: &SimpleCommunicator,
+    file: &File,
+    path: &Path,
+    g: &GaussRecords,
+    first: usize,
+) -> Result<(), CaseError> {
+    let Ok(group) = file.group(GROUP) else {
+        return Ok(());
+    };
+    let bad = |name: &str, m: String| {
+        CaseError::new(path, CaseErrorKind::Malformed, m).at(format!("dataset /{GROUP}/{name}"))
+    };
+    let check = |name: &str, width: usize, data: &[f64]| match group.dataset(name) {
+        Ok(ds) => checksum::verify(comm, &ds, first, width, data).map_err(|m| bad(name, m)),
+        Err(_) => Ok(()),
+    };
+    let key = group
+        .dataset("key")
+        .map_err(|_| bad("key", "missing".into()))?;
+    checksum::verify(comm, &key, first, 3, g.key.as_flattened()).map_err(|m| bad("key", m))?;
+    check("nodes", NODE_LEN, g.nodes.as_flattened())?;
+    check("contact", CONTACT_LEN, g.contact.as_flattened())?;
+    check("state", GAUSS_LEN, g.state.as_flattened())
 }

@@ -52,6 +52,11 @@ impl Lockstep<'_> {
         });
         agree(self.comm, self.path, local)
     }
+
+    /// Collective. The sum over ranks of `part` (wrapping).
+    pub(crate) fn total(&self, part: u64) -> u64 {
+        super::checksum::total(self.comm, part)
+    }
 }
 
 fn io_error(path: &Path, tmp: &Path, bytes: u64, e: &std::io::Error) -> CaseError {
