@@ -214,42 +214,6 @@ impl Halo {
         &self.ghost_owners
     }
 
-    /// Number of owned items the halo was built for.
-    pub fn n_owned(&self) -> usize {
-        self.n_owned
-    }
-
-    /// Number of ghosts.
-    pub fn n_ghosts(&self) -> usize {
-        self.ghost_ids.len()
-    }
-
-    /// Ranks that receive some of our owned items, ascending.
-    pub fn send_ranks(&self) -> &[i32] {
-        &self.send_ranks
-    }
-
-    /// Local indices of the owned items sent to `rank`, sorted by global id (empty when none).
-    pub fn send_indices(&self, rank: i32) -> &[usize] {
-        match self.send_ranks.binary_search(&rank) {
-            Ok(n) => &self.send_idx[self.send_off[n]..self.send_off[n + 1]],
-            Err(_) => &[],
-        }
-    }
-
-    /// Ranks we receive ghosts from, ascending.
-    pub fn recv_ranks(&self) -> &[i32] {
-        &self.recv_ranks
-    }
-
-    /// Number of ghosts received from `rank` (0 when none).
-    pub fn recv_count(&self, rank: i32) -> usize {
-        match self.recv_ranks.binary_search(&rank) {
-            Ok(n) => self.recv_off[n + 1] - self.recv_off[n],
-            Err(_) => 0,
-        }
-    }
-
     /// Collective. Generic halo exchange of fixed-stride f64 records: owned data (stride k per
     /// owned item, in owned order) -> ghost data (stride k per ghost, in ghost order). Bit-for-bit
     /// copies.
@@ -278,18 +242,6 @@ impl Halo {
     ) -> Result<Vec<f64>, PartitionError> {
         self.check(comm, owned.len(), k)?;
         Ok(self.exchange_f64(comm, owned, k))
-    }
-
-    /// Collective. Checked [`exchange_u64`](Halo::exchange_u64), see
-    /// [`try_exchange_f64`](Halo::try_exchange_f64).
-    pub fn try_exchange_u64(
-        &self,
-        comm: &Comm,
-        owned: &[u64],
-        k: usize,
-    ) -> Result<Vec<u64>, PartitionError> {
-        self.check(comm, owned.len(), k)?;
-        Ok(self.exchange_u64(comm, owned, k))
     }
 
     fn check(&self, comm: &Comm, len: usize, k: usize) -> Result<(), PartitionError> {

@@ -43,6 +43,43 @@ pub fn shape_of(s: &Scene, i: usize) -> Result<Shape, Invalid> {
     }
 }
 
+/// A body wished in place is lined with particles at the cloud's spacing (at most `mesh.h`, at
+/// least the finest `[[mesh.fine]]` spacing): its perimeter must stay within the particle limit
+/// (a radius of 1e308 made the lining's spacing NaN, and a large finite one exhausts memory).
+fn check_lining(s: &Scene, i: usize, shape: &Shape) -> Result<(), Invalid> {
+    let core = shape.core();
+    let edges: f64 = if core.len() > 1 {
+        (0..core.len())
+            .map(|k| {
+                let (a, b) = (core[k], core[(k + 1) % core.len()]);
+                (b[0] - a[0]).hypot(b[1] - a[1])
+            })
+            .sum()
+    } else {
+        0.0
+    };
+    let perimeter = edges + 2.0 * std::f64::consts::PI * shape.radius();
+    let finest = s.mesh.fine.iter().map(|f| f.h).fold(s.mesh.h, f64::min);
+    let points = perimeter / finest;
+    if points.is_finite() && points <= super::validate::MAX_PARTICLES as f64 {
+        return Ok(());
+    }
+    let path = FieldPath::key("rigid").at(i);
+    let path = if s.rigid[i].circle.is_some() {
+        path.join("circle").join("radius")
+    } else {
+        path.join("polygon")
+    };
+    fail(
+        path,
+        format!(
+            "the body's perimeter ({perimeter:.3e} m) would take {points:.3e} lining particles at              the spacing {finest}, more than the limit of {} ({})",
+            super::validate::MAX_PARTICLES,
+            super::validate::LIMIT_REASON
+        ),
+    )
+}
+
 pub fn check(s: &Scene) -> Result<(), Invalid> {
     let mut names = HashSet::new();
     for (i, r) in s.rigid.iter().enumerate() {
@@ -56,7 +93,7 @@ pub fn check(s: &Scene) -> Result<(), Invalid> {
         if !names.insert(r.name.clone()) {
             return fail(path.join("name"), format!("\"{}\" is used twice", r.name));
         }
-        shape_of(s, i)?;
+        check_lining(s, i, &shape_of(s, i)?)?;
         for (k, st) in r.stages.iter().enumerate() {
             let sp = path.join("stages").at(k);
             if !st.to.iter().all(|x| x.is_finite()) {
