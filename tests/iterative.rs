@@ -313,3 +313,23 @@ fn rigid_body_modes_are_in_the_kernel_of_the_stress_free_tangents() {
     );
     assert!(stretch[0] > 1e-3, "a stretch in the kernel: {stretch:?}");
 }
+
+#[test]
+fn a_linear_solve_that_does_not_converge_is_a_divergence_the_step_cuts_on() {
+    let dir = workdir("iterative-diverged");
+    common::small_cantilever(&dir, 10, &["solver.linear=\"iterative\""]);
+    // Three Krylov iterations cannot reach the tolerance: every piece fails, is retried with
+    // the other line search and cut, and the run ends naming both reasons.
+    let out = common::run(
+        &dir,
+        1,
+        &["c.h5", "--until-step", "1", "--", "-ksp_max_it", "3"],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("DIVERGED_LINEAR_SOLVE: the linear solver DIVERGED_ITS")
+            && stderr.contains("after 6 cuts"),
+        "{stderr}"
+    );
+}

@@ -5,7 +5,7 @@ use std::fmt;
 /// A PETSc call that returned a non-zero error code, or a callback of ours that failed.
 #[derive(Debug, Clone)]
 pub struct PetscError {
-    pub code: i32,
+    pub code: ffi::PetscErrorCode,
     pub message: String,
 }
 

@@ -85,6 +85,13 @@ impl Snes {
             let mut ksp: ffi::KSP = std::ptr::null_mut();
             check(ffi::SNESGetKSP(raw, &mut ksp), "SNESGetKSP")?;
             linear.configure(ksp)?;
+            check(
+                ffi::SNESSetLagPreconditioner(
+                    raw,
+                    to_int(linear.preconditioner_lag(), "preconditioner lag")?,
+                ),
+                "SNESSetLagPreconditioner",
+            )?;
             // The caller's line search: full steps for elastic large rotations (the residual grows
             // on the first iterate before the quadratic phase, and backtracking would crawl),
             // backtracking for plastic flow (elastic-plastic switching overshoots).

@@ -39,7 +39,7 @@ struct Split {
 const ITERATIVE_ABOVE_DOFS: usize = 60_000;
 /// Relative tolerance of an iterative linear solve: tight enough that Newton's iterates, and
 /// so the histories, match the direct solver's (measured, tests/iterative.rs).
-const LINEAR_RTOL: f64 = 1e-8;
+const LINEAR_RTOL: f64 = 1e-6;
 
 /// FNV-1a over the global dof numbers of every local triangle: equal signatures mean the same
 /// matrix pattern on this rank.
@@ -273,7 +273,8 @@ impl Simulation {
             LinearChoice::Direct => false,
             LinearChoice::Iterative => true,
             // The field split is left to an explicit choice: at yield its displacement block
-            // loses the stiffness AMG needs (bench/VALIDATION.md, "Iterative linear solver").
+            // loses the stiffness AMG needs (measured on block-compression, uniformly plastic
+            // at step 1: GMRES did not converge in 1000 iterations with GAMG on that block).
             LinearChoice::Auto => {
                 dofs.vertex_dofs == 2 && dofs.n_global_dofs > ITERATIVE_ABOVE_DOFS
             }
