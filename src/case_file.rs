@@ -58,12 +58,14 @@ mod summary;
 pub mod validate;
 #[path = "case_file/validate_blocks.rs"]
 mod validate_blocks;
+#[path = "case_file/write.rs"]
+mod write;
 
 use std::io::{Read, Seek, SeekFrom};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use hdf5::{Dataset, File, Group, H5Type};
+use hdf5::{Dataset, File, H5Type};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
 
@@ -71,11 +73,10 @@ pub use collective::block_range;
 pub use error::{CaseError, CaseErrorKind};
 pub use gauss::{GaussRecords, CONTACT_LEN, GAUSS_LEN, NODE_LEN};
 pub use particles::{ParticleSet, STATE_LEN};
+pub use write::{write_case, write_checkpoint};
 
 use crate::scene::{generate_particles, lattice, Scene};
-use checksum::Word;
 use collective::agree;
-use datasets::Column;
 pub(crate) use lockstep::{estimate as estimate_bytes, write_hdf5, Lockstep};
 
 /// Value of the `format` attribute.
@@ -205,40 +206,6 @@ pub(crate) fn mpio_file(
     }
 }
 
-/// Writes this rank's rows `rows` of column `c` (collective).
-fn write_column<T: H5Type>(
-    group: &Group,
-    c: &Column,
-    n: usize,
-    rows: Range<usize>,
-    data: &[T],
-) -> hdf5::Result<Dataset> {
-    let ds = datasets::create::<T>(group, c, n)?;
-    let space = ds.space()?;
-    let selected = if c.width == 0 {
-        space.select(rows)?
-    } else {
-        space.select((rows, ..))?
-    };
-    ffi::write_collective(&ds, &selected, data)?;
-    Ok(ds)
-}
-
-/// Collective. Column `c` and its checksum, each an agreed step.
-fn column_step<T: H5Type + Word>(
-    step: &Lockstep<'_>,
-    group: &Group,
-    c: &Column,
-    n: usize,
-    rows: Range<usize>,
-    data: &[T],
-) -> Result<(), CaseError> {
-    let what = format!("dataset /{}/{}", datasets::GROUP, c.name);
-    let ds = step.step(&what, write_column(group, c, n, rows.clone(), data))?;
-    let sum = step.total(checksum::rows_sum(rows.start, c.width, data));
-    step.step(&what, checksum::put(&ds, sum))
-}
-
 /// Reads rows `rows` of `ds` into `out` (collective).
 fn read_column<T: H5Type>(
     ds: &Dataset,
@@ -253,130 +220,6 @@ fn read_column<T: H5Type>(
         space.select((rows, ..))?
     };
     ffi::read_collective(ds, &selected, out)
-}
-
-/// Collective. The whole file, one agreed step per attribute set and dataset.
-#[allow(clippy::too_many_arguments)]
-fn write_contents(
-    file: &File,
-    step: &Lockstep<'_>,
-    header: &CaseHeader,
-    ranks: u32,
-    local: &ParticleSet,
-    rows: Range<usize>,
-    n: usize,
-    gauss: &GaussRecords,
-    gauss_rows: (Range<usize>, usize),
-) -> Result<(), CaseError> {
-    step.step("attributes", header::write_header(file, header, ranks))?;
-    gauss::write(file, step, gauss, gauss_rows.0, gauss_rows.1)?;
-    let group = step.step("group /particles", file.create_group(datasets::GROUP))?;
-    let [gid, position, displacement, h, state, flags, increment] = datasets::columns();
-    let (g, r) = (&group, rows);
-    column_step(step, g, &gid, n, r.clone(), &local.gid)?;
-    column_step(
-        step,
-        g,
-        &increment,
-        n,
-        r.clone(),
-        local.increment.as_flattened(),
-    )?;
-    column_step(
-        step,
-        g,
-        &position,
-        n,
-        r.clone(),
-        local.position.as_flattened(),
-    )?;
-    let displacements = local.displacement.as_flattened();
-    column_step(step, g, &displacement, n, r.clone(), displacements)?;
-    column_step(step, g, &h, n, r.clone(), &local.h)?;
-    column_step(step, g, &state, n, r.clone(), local.state.as_flattened())?;
-    column_step(step, g, &flags, n, r, &local.flags)
-}
-
-/// Collective. Writes a case file: every rank passes its own particles (any count, zero
-/// included), which are stored in rank order. The file is written as `path.tmp` and renamed to
-/// `path` by rank 0 once every rank has closed it, so an interrupted write never leaves a
-/// partial file under the final name. Its disk space is reserved first, so a full disk is an
-/// error before anything is written. On error every rank returns the same error, the temporary
-/// is removed, and a file already at `path` is left as it was.
-pub fn write_case(
-    comm: &SimpleCommunicator,
-    path: &Path,
-    header: &CaseHeader,
-    local: &ParticleSet,
-) -> Result<(), CaseError> {
-    write_checkpoint(comm, path, header, local, &GaussRecords::default())
-}
-
-/// Collective. [`write_case`] plus the Gauss states of this rank's owned triangles (group
-/// `/gauss`), so a restart continues exactly where the run stopped.
-pub fn write_checkpoint(
-    comm: &SimpleCommunicator,
-    path: &Path,
-    header: &CaseHeader,
-    local: &ParticleSet,
-    gauss: &GaussRecords,
-) -> Result<(), CaseError> {
-    let checked = local
-        .check_lengths()
-        .map_err(|m| CaseError::new(path, CaseErrorKind::InvalidInput, m));
-    agree(comm, path, checked)?;
-    check_output(comm, path, None)?;
-
-    let count = local.len() as u64;
-    let mut inclusive = 0u64;
-    comm.scan_into(
-        &count,
-        &mut inclusive,
-        mpi::collective::SystemOperation::sum(),
-    );
-    let mut total = 0u64;
-    comm.all_reduce_into(&count, &mut total, mpi::collective::SystemOperation::sum());
-    let start = (inclusive - count) as usize;
-    let rows = start..start + local.len();
-    let mut counts = vec![0u64; comm.size() as usize];
-    comm.all_gather_into(&count, &mut counts[..]);
-    let mut header = header.clone();
-    header.rank_counts = counts;
-    let gcount = gauss.len() as u64;
-    let mut ginclusive = 0u64;
-    comm.scan_into(
-        &gcount,
-        &mut ginclusive,
-        mpi::collective::SystemOperation::sum(),
-    );
-    let mut gtotal = 0u64;
-    comm.all_reduce_into(
-        &gcount,
-        &mut gtotal,
-        mpi::collective::SystemOperation::sum(),
-    );
-    let gstart = (ginclusive - gcount) as usize;
-    let gauss_rows = (gstart..gstart + gauss.len(), gtotal as usize);
-
-    let ranks = comm.size() as u32;
-    let raw = total * datasets::bytes_per_particle()
-        + gtotal * (8 * (3 + GAUSS_LEN + NODE_LEN + CONTACT_LEN)) as u64
-        + 8 * (header.tracked_gids.len() + header.rank_counts.len()) as u64;
-    let text =
-        (header.scene_toml.len() + header.scene_source.len() + header.code_version.len()) as u64;
-    lockstep::write_hdf5(comm, path, lockstep::estimate(raw, text), |file, step| {
-        write_contents(
-            file,
-            step,
-            &header,
-            ranks,
-            local,
-            rows,
-            total as usize,
-            gauss,
-            gauss_rows,
-        )
-    })
 }
 
 /// Collective. Refuses, on every rank, an output `path` that is not a regular file (or absent)

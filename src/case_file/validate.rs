@@ -268,7 +268,9 @@ pub fn check_triangle(
     }
     let area2 =
         (x[1][0] - x[0][0]) * (x[2][1] - x[0][1]) - (x[1][1] - x[0][1]) * (x[2][0] - x[0][0]);
-    if area2.is_nan() || area2 <= 0.0 {
+    // Exactly flat is let through: a sliver flattened by the last increment is no damage, and
+    // refusing it would make a sound checkpoint unusable.
+    if area2.is_nan() || area2 < 0.0 {
         return Err(bad(
             path,
             "dataset /gauss/key",
@@ -332,4 +334,23 @@ pub fn check_gauss_lengths(path: &Path, g: &GaussRecords) -> Result<(), CaseErro
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triangles_must_be_counter_clockwise_flat_ones_pass() {
+        let p = Path::new("c.h5");
+        let (a, b, c) = ([0.0, 0.0], [1.0, 0.0], [0.0, 1.0]);
+        assert!(check_triangle(p, [1, 2, 3], [Some(a), Some(b), Some(c)]).is_ok());
+        let e = check_triangle(p, [1, 3, 2], [Some(a), Some(c), Some(b)]).unwrap_err();
+        assert!(e.to_string().contains("not counter-clockwise"), "{e}");
+        assert!(check_triangle(p, [1, 2, 3], [Some(a), Some(b), Some([2.0, 0.0])]).is_ok());
+        let e = check_triangle(p, [1, 2, 3], [Some(a), None, Some(c)]).unwrap_err();
+        assert!(e.to_string().contains("vertex 2 is no particle"), "{e}");
+        let nan = [f64::NAN, 0.0];
+        assert!(check_triangle(p, [1, 2, 3], [Some(a), Some(b), Some(nan)]).is_err());
+    }
 }
