@@ -29,17 +29,28 @@ pub struct SolverObjects {
 /// The Schur-complement field split of a mixed system.
 struct Split {
     layout: FieldLayout,
-    _displacement: IndexSet,
-    _pressure: IndexSet,
+    displacement_field: IndexSet,
+    pressure_field: IndexSet,
     pressure_mass: Mat,
 }
 
-/// Global dofs from which `solver.linear = "auto"` solves iteratively: the crossover of the
-/// two paths measured on the cantilever (bench/solver_scaling.sh, 2-core machine).
-const ITERATIVE_ABOVE_DOFS: usize = 60_000;
-/// Relative tolerance of an iterative linear solve: tight enough that Newton's iterates, and
-/// so the histories, match the direct solver's (measured, tests/iterative.rs).
-const LINEAR_RTOL: f64 = 1e-6;
+/// Global dofs above which `solver.linear = "auto"` solves iteratively. Not a speed crossover:
+/// on the cantilever (bench/solver_scaling.sh, 1 rank, 2-core shared machine, OpenBLAS) the
+/// direct path took less CPU per Newton iteration at every size measured, 1.9x less at 21 k
+/// dofs (h = 1/16) and 2.4x less at 330 k dofs (h = 1/64), and the gap did not close. It is a
+/// memory limit: MUMPS held about 2.6 kB per dof (880 MB at 330 k dofs), against 1.9 kB for
+/// the iterative path (639 MB), so at 2 M dofs (about 250 k particles) the factorisation
+/// needs about 5 GB, and above that the iterative path keeps large runs in memory.
+const ITERATIVE_ABOVE_DOFS: usize = 2_000_000;
+/// Relative tolerances of the iterative linear solves: tight enough that Newton's iterates, and
+/// so the histories, match the direct solver's (tests/iterative.rs: 1e-11 relative or closer).
+/// GMRES+GAMG on the cantilever (h = 1/8, 5 steps): 1e-6 kept the direct path's 35 Newton
+/// iterations with 1082 Krylov iterations against 1342 at 1e-8. The field split at 1e-6 added
+/// Newton iterations on the ν = 0.4999 block (10 instead of 8 at h = 0.1 and 0.05, 13 instead of
+/// 10 at h = 0.025) and so about as many Krylov iterations as 1e-8 (320 vs 332, 343 vs 367, 476
+/// vs 494), so it solves to 1e-8.
+const AMG_RTOL: f64 = 1e-6;
+const SCHUR_RTOL: f64 = 1e-8;
 
 /// FNV-1a over the global dof numbers of every local triangle: equal signatures mean the same
 /// matrix pattern on this rank.
@@ -286,12 +297,12 @@ impl Simulation {
         };
         let linear = match &split {
             Some(s) => LinearSolver::Schur {
-                rtol: LINEAR_RTOL,
-                displacement: &s._displacement,
-                pressure: &s._pressure,
+                rtol: SCHUR_RTOL,
+                displacement: &s.displacement_field,
+                pressure: &s.pressure_field,
                 pressure_mass: &s.pressure_mass,
             },
-            None if iterative => LinearSolver::Amg { rtol: LINEAR_RTOL },
+            None if iterative => LinearSolver::Amg { rtol: AMG_RTOL },
             None => LinearSolver::Direct,
         };
         let snes = Snes::new(
@@ -336,8 +347,8 @@ impl Simulation {
         let pressure_mass = Mat::aij(world, n_p, 1, &layout.mass_d_nnz, &layout.mass_o_nnz)?;
         Ok(Split {
             layout,
-            _displacement: displacement,
-            _pressure: pressure,
+            displacement_field: displacement,
+            pressure_field: pressure,
             pressure_mass,
         })
     }
