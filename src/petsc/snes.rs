@@ -61,6 +61,7 @@ impl Snes {
     /// reproducible on 2 ranks. Every choice is overridable by PETSc options on the command line.
     pub fn new(
         comm: &SimpleCommunicator,
+        abstol: f64,
         rtol: f64,
         max_it: usize,
         line_search: &str,
@@ -74,7 +75,7 @@ impl Snes {
             check(
                 ffi::SNESSetTolerances(
                     raw,
-                    1e-50,
+                    abstol,
                     rtol,
                     STEP_TOL,
                     to_int(max_it, "solver.newton_max_it")?,

@@ -305,8 +305,14 @@ impl Simulation {
             None if iterative => LinearSolver::Amg { rtol: AMG_RTOL },
             None => LinearSolver::Direct,
         };
+        // A residual at round-off of the body's force scale (E h, N/m) is converged: a step
+        // with no load at all (a body released from its platen) has no first residual for the
+        // relative test to refer to, and its line search fails at 1e-26.
+        let scene = &self.model.scene;
+        let abstol = 1e-14 * scene.material.young * scene.mesh.h;
         let snes = Snes::new(
             world,
+            abstol,
             solver.newton_rtol,
             solver.newton_max_it as usize,
             line_search,
