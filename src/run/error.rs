@@ -259,4 +259,47 @@ mod tests {
         let other = agreed(None, Some("from rank 0".into())).unwrap_err();
         assert!(matches!(other, RunError::Agreed(ref m) if m == "from rank 0"));
     }
+
+    /// The texts the run printed before the typed error (tests/ match parts of them).
+    #[test]
+    fn messages_keep_their_text() {
+        let penetration = RunError::Penetration {
+            step: 4,
+            gid: 17,
+            body: "footing".into(),
+            depth: 0.61234,
+            limit: 0.5,
+        };
+        assert_eq!(
+            penetration.to_string(),
+            "step 4: particle 17 is inside rigid body 'footing' by 0.612 of its spacing (limit \
+             0.5): the soil passed through the body; try a larger contact.penalty or more steps"
+        );
+        let diverged = RunError::Diverged {
+            message: "step 2: diverged".into(),
+            piece: 64.0,
+            cuts: 6,
+            from: 0.25,
+            advice: "try more steps".into(),
+        };
+        assert_eq!(
+            diverged.to_string(),
+            "step 2: diverged, on a piece of 1/64 of the step after 6 cuts (from load factor \
+             0.250000); try more steps"
+        );
+        let until = RunError::UntilStep {
+            until: 0,
+            reason: "a run stops after a step it has made; give a step from 1 to 3".into(),
+        };
+        assert_eq!(
+            until.to_string(),
+            "--until-step 0: nothing to run, a run stops after a step it has made; give a step \
+             from 1 to 3"
+        );
+        let io = RunError::Io {
+            path: "out/scene.toml".into(),
+            message: "No space left on device".into(),
+        };
+        assert_eq!(io.to_string(), "out/scene.toml: No space left on device");
+    }
 }
