@@ -5,7 +5,7 @@ use crate::case_file::{check_output, new_case, summarize, write_case};
 use crate::cli::{default_out_dir, Command};
 use crate::mesh::fingerprint::fingerprint;
 use crate::petsc::Petsc;
-use crate::run::{run, RunOptions, Simulation};
+use crate::run::{run, RunError, RunOptions, Simulation};
 use crate::scene::{load_scene, scene_file};
 use mpi::traits::Communicator;
 use pfem_partition::{gather_to_root, sum_f64, Comm};
@@ -27,7 +27,7 @@ pub fn execute(command: Command) -> i32 {
             if world.rank() == 0 {
                 summarize(&file)
                     .map(|s| print!("{s}"))
-                    .map_err(|e| e.to_string())
+                    .map_err(RunError::from)
             } else {
                 Ok(())
             }
@@ -52,7 +52,7 @@ pub fn execute(command: Command) -> i32 {
                         until_step,
                     },
                 ),
-                Err(e) => Err(e.to_string()),
+                Err(e) => Err(e.into()),
             }
         }
         Command::Help | Command::Version => Ok(()),
@@ -63,21 +63,21 @@ pub fn execute(command: Command) -> i32 {
             if world.rank() == 0 {
                 eprintln!("pfem-mpi: error: {e}");
             }
-            1
+            e.exit_code()
         }
     }
 }
 
 /// Collective. Rank 0 generates the particles; all ranks write the file together. The output
 /// is checked first, so a refused destination costs no particle generation.
-fn new(world: &Comm, scene: &str, out: &std::path::Path, sets: &[String]) -> Result<(), String> {
-    check_output(world, out, scene_file(scene)).map_err(|e| e.to_string())?;
-    let (scene_v, _toml) = load_scene(scene, sets).map_err(|e| e.to_string())?;
+fn new(world: &Comm, scene: &str, out: &std::path::Path, sets: &[String]) -> Result<(), RunError> {
+    check_output(world, out, scene_file(scene))?;
+    let (scene_v, _toml) = load_scene(scene, sets)?;
     let (header, mut set) = new_case(&scene_v, scene);
     if world.rank() != 0 {
         set = Default::default();
     }
-    write_case(world, out, &header, &set).map_err(|e| e.to_string())?;
+    write_case(world, out, &header, &set)?;
     if world.rank() == 0 {
         println!(
             "wrote {} ({} particles, scene {})",
@@ -94,11 +94,11 @@ fn header_particles(set: &crate::case_file::ParticleSet) -> usize {
 }
 
 /// Rank 0 draws the pictures of a run folder.
-fn plot(world: &Comm, dir: &std::path::Path) -> Result<(), String> {
+fn plot(world: &Comm, dir: &std::path::Path) -> Result<(), RunError> {
     if world.rank() != 0 {
         return Ok(());
     }
-    let files = crate::plot::plot_run(dir).map_err(|e| e.to_string())?;
+    let files = crate::plot::plot_run(dir)?;
     for f in files {
         println!("wrote {}", f.display());
     }
@@ -106,7 +106,7 @@ fn plot(world: &Comm, dir: &std::path::Path) -> Result<(), String> {
 }
 
 /// Collective. Meshes the case once and prints the rank-count independent fingerprint.
-fn mesh(world: &Comm, file: &std::path::Path) -> Result<(), String> {
+fn mesh(world: &Comm, file: &std::path::Path) -> Result<(), RunError> {
     let mut sim = Simulation::load(world, file)?;
     let mesh = sim.remesh(world)?;
     let owned: Vec<u64> = (0..mesh.tris.len())

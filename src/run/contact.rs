@@ -202,7 +202,10 @@ impl Simulation {
     /// Collective. The deepest penetration of a particle into a rigid body, as a fraction of
     /// its spacing (0 when none), and an error when it passes [`PENETRATION_LIMIT`]: the soil
     /// has passed through the body.
-    pub(super) fn check_penetration(&self, world: &pfem_partition::Comm) -> Result<f64, String> {
+    pub(super) fn check_penetration(
+        &self,
+        world: &pfem_partition::Comm,
+    ) -> Result<f64, super::RunError> {
         if self.model.bodies.is_empty() {
             return Ok(0.0);
         }
@@ -220,20 +223,17 @@ impl Simulation {
         }
         let local = worst.map_or(0.0, |w| w.0.max(0.0));
         let deepest = pfem_partition::max_f64(world, local);
-        let message = worst
+        let error = worst
             .filter(|w| w.0 > PENETRATION_LIMIT)
-            .map(|(d, gid, bi)| {
-                format!(
-                    "step {}: particle {gid} is inside rigid body '{}' by {d:.3} of its spacing \
-                 (limit {PENETRATION_LIMIT}): the soil passed through the body; try a larger \
-                 contact.penalty or more steps",
-                    self.header.step, self.model.bodies[bi].name
-                )
+            .map(|(depth, gid, bi)| super::RunError::Penetration {
+                step: self.header.step,
+                gid,
+                body: self.model.bodies[bi].name.clone(),
+                depth,
+                limit: PENETRATION_LIMIT,
             });
-        match pfem_partition::agree_on_error(world, message) {
-            Some(e) => Err(e),
-            None => Ok(deepest),
-        }
+        super::error::agree(world, error)?;
+        Ok(deepest)
     }
 }
 

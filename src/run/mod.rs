@@ -1,6 +1,7 @@
 //! The PFEM step loop (the method's Fig. 1): remesh, map, solve, update, output, checkpoint.
 
 mod contact;
+mod error;
 mod output;
 mod progress;
 mod refinement;
@@ -11,6 +12,7 @@ mod simulation;
 mod step;
 mod test_hooks;
 
+pub use error::{RunError, EXIT_FAILURE, EXIT_USAGE};
 pub use simulation::{Simulation, StepReport};
 
 use crate::petsc::Petsc;
@@ -34,7 +36,7 @@ const ERROR_PATIENCE: std::time::Duration = std::time::Duration::from_secs(5);
 /// Collective on `errors`, a communicator nothing else uses (a duplicate of the world): every
 /// rank gets the lowest failing rank's error; a rank that failed alone while the others wait in
 /// another collective prints its error and aborts the job after [`ERROR_PATIENCE`].
-pub fn agree_or_abort(errors: &Comm, local: Result<(), String>) -> Result<(), String> {
+pub fn agree_or_abort(errors: &Comm, local: Result<(), RunError>) -> Result<(), RunError> {
     let rank = errors.rank();
     let abandon = |e: &str| {
         eprintln!(
@@ -42,15 +44,15 @@ pub fn agree_or_abort(errors: &Comm, local: Result<(), String>) -> Result<(), St
              aborting the job)"
         )
     };
-    match pfem_partition::agree_on_error_or_abort(errors, local.err(), ERROR_PATIENCE, abandon) {
-        None => Ok(()),
-        Some(e) => Err(e),
-    }
+    let local = local.err();
+    let message = local.as_ref().map(|e| e.to_string());
+    let agreed = pfem_partition::agree_on_error_or_abort(errors, message, ERROR_PATIENCE, abandon);
+    error::agreed(local, agreed)
 }
 
 /// Collective. Runs the case to its last step (or `until_step`, or the step during which SIGTERM
 /// or SIGUSR1 arrived), ending with a checkpoint.
-pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), String> {
+pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), RunError> {
     let errors = world.duplicate();
     let mut held = None;
     let outcome = drive(world, petsc, opts, &mut held);
@@ -66,7 +68,7 @@ fn drive(
     petsc: &Petsc,
     opts: &RunOptions,
     held: &mut Option<Simulation>,
-) -> Result<(), String> {
+) -> Result<(), RunError> {
     let stop = signals::StopRequest::install()?;
     let rank = world.rank();
     let fault = |phase: &str, step: u64| test_hooks::inject(rank, phase, step);

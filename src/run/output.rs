@@ -1,6 +1,7 @@
 //! What a run leaves in its output folder: history.csv, ParaView fields, checkpoints.
 
-use super::Simulation;
+use super::error::agree;
+use super::{RunError, Simulation};
 use crate::history::{self, HistoryFile};
 use crate::mesh::LocalMesh;
 use crate::output::{Field, FieldsWriter, Frame};
@@ -18,59 +19,55 @@ pub struct Output {
 
 /// `DIR/scene.toml`: the resolved scene of the run, which the plots read for the declared
 /// columns' reference lines (written to a temporary name and renamed).
-fn write_scene(dir: &Path, sim: &Simulation) -> Result<(), String> {
+fn write_scene(dir: &Path, sim: &Simulation) -> Result<(), RunError> {
     let path = dir.join("scene.toml");
     crate::output::replace_file(&path, sim.scene().to_toml().as_bytes())
-        .map_err(|m| format!("{}: {m}", path.display()))
+        .map_err(|message| RunError::Io { path, message })
 }
 
 /// Refuses a folder that holds another case's run: its checkpoints, history and fields would be
 /// mixed with this one's, and pruning would delete the other run's checkpoints. The folder's
 /// `scene.toml` tells: a continuation of the same case has the same scene.
-fn check_same_case(dir: &Path, sim: &Simulation) -> Result<(), String> {
+fn check_same_case(dir: &Path, sim: &Simulation) -> Result<(), RunError> {
     let path = dir.join("scene.toml");
     let Ok(text) = std::fs::read_to_string(&path) else {
         return Ok(());
     };
-    let name = path.display().to_string();
-    match crate::scene::Scene::from_toml(&text, &name, &[]) {
+    let dir = dir.to_path_buf();
+    match crate::scene::Scene::from_toml(&text, &path.display().to_string(), &[]) {
         Ok(scene) if &scene == sim.scene() => Ok(()),
-        Err(e) => Err(format!(
-            "{}: its scene.toml cannot be read back ({e}), so it cannot be told apart from \
-             another case's output; give another --out folder, or remove this one",
-            dir.display()
-        )),
-        Ok(_) => Err(format!(
-            "{}: holds the output of another case ({name} is not this case's scene); give \
-             another --out folder, or remove this one to start over",
-            dir.display()
-        )),
+        Err(error) => Err(RunError::UnreadableOutput { dir, error }),
+        Ok(_) => Err(RunError::OtherCase {
+            dir,
+            scene_file: path,
+        }),
     }
 }
 
 impl Output {
     /// Collective. Creates `DIR` (rank 0) and opens the history, keeping rows of earlier runs up to
     /// the restart step. A `DIR` holding another case's run is refused.
-    pub fn open(world: &Comm, sim: &Simulation, dir: &Path) -> Result<Output, String> {
+    pub fn open(world: &Comm, sim: &Simulation, dir: &Path) -> Result<Output, RunError> {
         let mut local = None;
         let mut history = None;
         if world.rank() == 0 {
             match check_same_case(dir, sim)
                 .and_then(|_| {
-                    std::fs::create_dir_all(dir.join("checkpoints"))
-                        .map_err(|e| format!("{}: {e}", dir.display()))
+                    std::fs::create_dir_all(dir.join("checkpoints")).map_err(|e| RunError::Io {
+                        path: dir.to_path_buf(),
+                        message: e.to_string(),
+                    })
                 })
                 .and_then(|_| write_scene(dir, sim))
-                .and_then(|_| HistoryFile::open(dir, sim.scene(), sim.step()))
-            {
+                .and_then(|_| {
+                    HistoryFile::open(dir, sim.scene(), sim.step()).map_err(RunError::History)
+                }) {
                 Ok(h) => history = Some(h),
                 Err(e) => local = Some(e),
             }
         }
-        if let Some(e) = pfem_partition::agree_on_error(world, local) {
-            return Err(e);
-        }
-        let fields = FieldsWriter::open(world, dir, sim.step()).map_err(|e| e.to_string())?;
+        agree(world, local)?;
+        let fields = FieldsWriter::open(world, dir, sim.step())?;
         Ok(Output {
             dir: dir.to_path_buf(),
             history,
@@ -87,7 +84,7 @@ impl Output {
         sim: &Simulation,
         mesh: &LocalMesh,
         last: u64,
-    ) -> Result<(), String> {
+    ) -> Result<(), RunError> {
         let every = sim.scene().output.fields_every as u64;
         let step = sim.step();
         if step != last && (every == 0 || !step.is_multiple_of(every)) {
@@ -131,37 +128,29 @@ impl Output {
             triangles: &triangles,
             owner_of: &owner_of,
         };
-        self.fields.write(world, &frame).map_err(|e| e.to_string())
+        Ok(self.fields.write(world, &frame)?)
     }
 
     /// Collective. Rank 0 draws the run's pictures (`pfem-mpi plot DIR` redraws them).
-    pub fn plot(&self, world: &Comm) -> Result<(), String> {
+    pub fn plot(&self, world: &Comm) -> Result<(), RunError> {
         let local = if world.rank() == 0 {
-            crate::plot::plot_run(&self.dir)
-                .err()
-                .map(|e| e.to_string())
+            crate::plot::plot_run(&self.dir).err().map(RunError::from)
         } else {
             None
         };
-        match pfem_partition::agree_on_error(world, local) {
-            Some(e) => Err(e),
-            None => Ok(()),
-        }
+        agree(world, local)
     }
 
     /// Collective. Appends the step's row.
-    pub fn record(&mut self, world: &Comm, sim: &Simulation) -> Result<(), String> {
+    pub fn record(&mut self, world: &Comm, sim: &Simulation) -> Result<(), RunError> {
         let m = sim.measures(world);
         let mut local = None;
         if let Some(h) = self.history.as_mut() {
             if let Err(e) = history::row(sim.scene(), &m).and_then(|r| h.append(sim.step(), &r)) {
-                local = Some(e);
+                local = Some(RunError::History(e));
             }
         }
-        match pfem_partition::agree_on_error(world, local) {
-            Some(e) => Err(e),
-            None => Ok(()),
-        }
+        agree(world, local)
     }
 
     /// Collective. Checkpoint every K steps (scene setting) and at the last step of the run.
@@ -170,7 +159,7 @@ impl Output {
         world: &Comm,
         sim: &Simulation,
         last: u64,
-    ) -> Result<(), String> {
+    ) -> Result<(), RunError> {
         let every = sim.scene().output.checkpoint_every as u64;
         let step = sim.step();
         if step != last && (every == 0 || !step.is_multiple_of(every)) {

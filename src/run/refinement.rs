@@ -18,7 +18,11 @@ const SLIDING_GAP: f64 = 0.1;
 impl Simulation {
     /// Collective. Inserts, removes and smooths particles as the scene asks; returns whether
     /// anything changed anywhere (then the mesh must be rebuilt).
-    pub(super) fn refine(&mut self, world: &Comm, mesh: &LocalMesh) -> Result<bool, String> {
+    pub(super) fn refine(
+        &mut self,
+        world: &Comm,
+        mesh: &LocalMesh,
+    ) -> Result<bool, super::RunError> {
         let settings = &self.model.scene.mesh;
         if !settings.refine && !settings.smooth {
             return Ok(false);
@@ -131,9 +135,7 @@ impl Simulation {
             let (a, b) = (*a as usize, *b as usize);
             let key = [mesh.gids[a], mesh.gids[b]];
             let Ok(rank) = all.binary_search(&key) else {
-                return Err(format!(
-                    "refinement: edge {key:?} missing from the global list"
-                ));
+                return Err(super::RunError::Refinement { edge: key });
             };
             let (sa, sb) = (value(a), value(b));
             let state: [f64; K] = std::array::from_fn(|k| 0.5 * (sa[k] + sb[k]));

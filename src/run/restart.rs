@@ -30,7 +30,11 @@ fn tri_node_keys(t: &[u64; 3]) -> [[u64; 2]; 6] {
 
 impl Simulation {
     /// Collective. Writes this state as a case file that any rank count can continue from.
-    pub fn write_checkpoint(&self, world: &Comm, path: &std::path::Path) -> Result<(), String> {
+    pub fn write_checkpoint(
+        &self,
+        world: &Comm,
+        path: &std::path::Path,
+    ) -> Result<(), super::RunError> {
         let p = &self.particles;
         let set = ParticleSet {
             gid: p.gid.clone(),
@@ -44,7 +48,7 @@ impl Simulation {
         let records = self.gauss_records();
         let mut header = self.header.clone();
         header.code_version = env!("CARGO_PKG_VERSION").to_string();
-        write_checkpoint(world, path, &header, &set, &records).map_err(|e| e.to_string())
+        Ok(write_checkpoint(world, path, &header, &set, &records)?)
     }
 
     /// The Gauss states of the last mesh with its node values (the Newton predictor) and contact

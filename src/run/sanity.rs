@@ -3,7 +3,7 @@
 //! triangle left, its area collapsed, a point load on a particle the mesh no longer holds),
 //! where the solver has nothing left to fail on and would report success.
 
-use super::{RunOptions, Simulation, StepReport};
+use super::{RunError, RunOptions, Simulation, StepReport};
 use crate::mesh::LocalMesh;
 use crate::scene::Scene;
 use pfem_partition::{sum_f64, Comm};
@@ -15,7 +15,7 @@ pub(super) const MIN_AREA_RATIO: f64 = 0.5;
 
 /// Refuses an `--until-step` that leaves nothing to run: 0, or a step the case has already
 /// reached. Not collective: every rank holds the same header, so every rank agrees.
-pub(super) fn check_until_step(opts: &RunOptions, sim: &Simulation) -> Result<(), String> {
+pub(super) fn check_until_step(opts: &RunOptions, sim: &Simulation) -> Result<(), RunError> {
     let Some(until) = opts.until_step else {
         return Ok(());
     };
@@ -33,9 +33,10 @@ pub(super) fn check_until_step(opts: &RunOptions, sim: &Simulation) -> Result<()
     } else {
         format!("the case has made all its steps (steps.count = {total})")
     };
-    Err(format!(
-        "--until-step {until}: nothing to run, {why}; {instead}"
-    ))
+    Err(RunError::UntilStep {
+        until,
+        reason: format!("{why}; {instead}"),
+    })
 }
 
 /// Area of the union of the scene's body rectangles (overlaps counted once).
@@ -83,7 +84,7 @@ pub(super) fn check_step(
     sim: &Simulation,
     mesh: &LocalMesh,
     report: &StepReport,
-) -> Result<(), String> {
+) -> Result<(), RunError> {
     let scene = sim.scene();
     let step = sim.step();
     let loads = &scene.point_load;
@@ -99,28 +100,37 @@ pub(super) fn check_step(
     let global = sum_f64(world, &local);
     let stop = "the run stops before writing this step";
     if report.triangles == 0 {
-        return Err(format!(
-            "step {step}: the mesh has no triangle left: the body was crushed or torn apart \
-             (no particles within alpha * h of each other); {stop}"
-        ));
+        return Err(RunError::Sanity {
+            step,
+            what: format!(
+                "the mesh has no triangle left: the body was crushed or torn apart (no \
+                 particles within alpha * h of each other); {stop}"
+            ),
+        });
     }
     let ratio = global[0] / body_area(scene);
     if ratio.is_nan() || ratio < MIN_AREA_RATIO {
-        return Err(format!(
-            "step {step}: the body's area is {ratio:.3} of its initial area (limit \
-             {MIN_AREA_RATIO}): it was crushed or inverted; {stop}"
-        ));
+        return Err(RunError::Sanity {
+            step,
+            what: format!(
+                "the body's area is {ratio:.3} of its initial area (limit {MIN_AREA_RATIO}): \
+                 it was crushed or inverted; {stop}"
+            ),
+        });
     }
     if let Some(k) = global[1..].iter().position(|&held| held == 0.0) {
         let particle = match sim.header.tracked_gids.get(k) {
             Some(g) => format!("its particle (gid {g}) is in no triangle of the mesh"),
             None => "the case file's tracked_gids names no particle for it".to_string(),
         };
-        return Err(format!(
-            "step {step}: point_load[{k}] at [{}, {}] does not reach the body: {particle}, so \
-             the load was not applied; {stop}",
-            loads[k].at[0], loads[k].at[1]
-        ));
+        return Err(RunError::Sanity {
+            step,
+            what: format!(
+                "point_load[{k}] at [{}, {}] does not reach the body: {particle}, so the load \
+                 was not applied; {stop}",
+                loads[k].at[0], loads[k].at[1]
+            ),
+        });
     }
     Ok(())
 }

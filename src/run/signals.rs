@@ -11,11 +11,11 @@ pub struct StopRequest {
 
 impl StopRequest {
     /// Installs the handlers (they only set a flag).
-    pub fn install() -> Result<StopRequest, String> {
+    pub fn install() -> Result<StopRequest, super::RunError> {
         let flag = Arc::new(AtomicBool::new(false));
         for sig in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGUSR1] {
             signal_hook::flag::register(sig, Arc::clone(&flag))
-                .map_err(|e| format!("cannot install the handler for signal {sig}: {e}"))?;
+                .map_err(|error| super::RunError::Signal { signal: sig, error })?;
         }
         Ok(StopRequest { flag })
     }

@@ -1,5 +1,6 @@
 //! The state of a running analysis on one rank and one function per phase of the method.
 
+use super::RunError;
 use crate::case_file::{read_checkpoint, CaseHeader};
 use crate::history::Measures;
 use crate::mapping::{map_states, TriStates};
@@ -67,18 +68,16 @@ pub struct StepReport {
     pub contact_seconds: f64,
 }
 
-fn err<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
-}
-
 impl Simulation {
     /// Collective. Reads a case or checkpoint on any rank count and partitions it with METIS.
-    pub fn load(world: &Comm, path: &Path) -> Result<Simulation, String> {
-        let (header, set, gauss) = read_checkpoint(world, path).map_err(err)?;
+    pub fn load(world: &Comm, path: &Path) -> Result<Simulation, RunError> {
+        let (header, set, gauss) = read_checkpoint(world, path)?;
         let same_partition = header.step > 0 && header.rank_counts.len() == world.size() as usize;
-        let scene = Scene::from_toml(&header.scene_toml, &path.display().to_string(), &[])
-            .map_err(|e| e.to_string())?;
-        let model = Model::new(&scene).map_err(|e| format!("{}: {e}", path.display()))?;
+        let scene = Scene::from_toml(&header.scene_toml, &path.display().to_string(), &[])?;
+        let model = Model::new(&scene).map_err(|message| RunError::Model {
+            case: path.to_path_buf(),
+            message,
+        })?;
         let mut particles = Particles {
             gid: set.gid,
             position: set.position,
@@ -142,7 +141,7 @@ impl Simulation {
 
     /// Collective. Delaunay of owned particles plus halo, alpha shape, triangles around owned
     /// particles.
-    pub fn remesh(&mut self, world: &Comm) -> Result<LocalMesh, String> {
+    pub fn remesh(&mut self, world: &Comm) -> Result<LocalMesh, RunError> {
         let mesh = self.build_mesh(world)?;
         if self.refine(world, &mesh)? {
             return self.build_mesh(world);
@@ -151,10 +150,10 @@ impl Simulation {
     }
 
     /// Collective. The mesh of the current particles, without refinement.
-    pub(super) fn build_mesh(&mut self, world: &Comm) -> Result<LocalMesh, String> {
+    pub(super) fn build_mesh(&mut self, world: &Comm) -> Result<LocalMesh, RunError> {
         let h_max = max_f64(world, self.particles.h.iter().copied().fold(0.0, f64::max));
         let width = halo_width(self.model.scene.mesh.alpha, h_max);
-        let (_halo, ghosts) = self.particles.ghosts(world, width).map_err(err)?;
+        let (_halo, ghosts) = self.particles.ghosts(world, width)?;
         self.ghosts = ghosts;
         #[cfg(debug_assertions)]
         check_halo(world, &self.particles, &self.ghosts, width)?;
@@ -169,8 +168,7 @@ impl Simulation {
         let h: Vec<f64> = p.h.iter().chain(&g.h).copied().collect();
         let alpha = self.model.scene.mesh.alpha;
         let n = p.len();
-        let mut mesh =
-            LocalMesh::build(points, gids, owner, h, n, rank, alpha, true).map_err(err)?;
+        let mut mesh = LocalMesh::build(points, gids, owner, h, n, rank, alpha, true)?;
         // One rank's unsettled near ties put every rank back on the exact Delaunay mesh.
         if max_f64(world, if mesh.ties_settled { 0.0 } else { 1.0 }) > 0.0 {
             let LocalMesh {
@@ -180,7 +178,7 @@ impl Simulation {
                 h,
                 ..
             } = mesh;
-            mesh = LocalMesh::build(points, gids, owner, h, n, rank, alpha, false).map_err(err)?;
+            mesh = LocalMesh::build(points, gids, owner, h, n, rank, alpha, false)?;
         }
         self.drop_crossing(&mut mesh, rank);
         Ok(mesh)
@@ -304,7 +302,7 @@ impl Simulation {
     /// Collective. Repartitions with METIS when the load is out of balance and a better balance
     /// exists: with N particles on P ranks no partition beats ceil(N/P) on the largest rank (9
     /// particles on 4 ranks stay at 3, 2, 2, 2).
-    pub fn rebalance_if_needed(&mut self, world: &Comm) -> Result<(), String> {
+    pub fn rebalance_if_needed(&mut self, world: &Comm) -> Result<(), RunError> {
         if world.size() > 1 && super::test_hooks::rotate_partition() {
             return self.repartition(world, Repartition::Rotated);
         }
@@ -325,7 +323,7 @@ impl Simulation {
     /// The Gauss states of the last
     /// mesh, the Newton predictor at its nodes and the contact state go with the particles (by
     /// triangle and node key, as on restart), so a repartition does not change the results.
-    fn repartition(&mut self, world: &Comm, mode: Repartition) -> Result<(), String> {
+    fn repartition(&mut self, world: &Comm, mode: Repartition) -> Result<(), RunError> {
         let mesh = self.build_mesh(world)?;
         let n = mesh.n_owned;
         let mut adj: Vec<Vec<u64>> = vec![Vec::new(); n];
@@ -348,7 +346,7 @@ impl Simulation {
             adjncy.extend(a);
             xadj.push(adjncy.len());
         }
-        let mut dest = partition_graph(world, &self.particles.gid, &xadj, &adjncy).map_err(err)?;
+        let mut dest = partition_graph(world, &self.particles.gid, &xadj, &adjncy)?;
         let size = world.size() as usize;
         if mode == Repartition::Rotated {
             dest.iter_mut().for_each(|r| *r = (*r + 1) % size as i32);
@@ -407,7 +405,7 @@ fn rank_counts(world: &Comm, n_local: usize) -> Vec<u64> {
 /// Debug builds: every particle within the halo width of an owned one is on this rank, checked
 /// against the full cloud gathered everywhere (too costly for release runs).
 #[cfg(debug_assertions)]
-fn check_halo(world: &Comm, p: &Particles, g: &Ghosts, width: f64) -> Result<(), String> {
+fn check_halo(world: &Comm, p: &Particles, g: &Ghosts, width: f64) -> Result<(), RunError> {
     use pfem_partition::allgather_u64;
     let mine: Vec<u64> = (0..p.len())
         .flat_map(|i| {
@@ -433,8 +431,7 @@ fn check_halo(world: &Comm, p: &Particles, g: &Ghosts, width: f64) -> Result<(),
             }
         }
     }
-    match pfem_partition::agree_on_error(world, missing.map(|m| format!("halo check: particle {m} is within the halo width {width} of an owned particle but not on rank {}", world.rank()))) {
-        Some(e) => Err(e),
-        None => Ok(()),
-    }
+    let rank = world.rank();
+    let missing = missing.map(|gid| RunError::Halo { gid, width, rank });
+    super::error::agree(world, missing)
 }

@@ -564,7 +564,7 @@ impl Simulation {
         mesh: &LocalMesh,
         solved: Solved,
         completes: bool,
-    ) -> Result<StepReport, String> {
+    ) -> Result<StepReport, super::RunError> {
         // Increments are kept per whole step: the predictor of the next increment scales them.
         let per_step = 1.0 / (solved.dlambda * self.model.scene.steps.count as f64);
         for i in 0..self.particles.len() {
@@ -646,7 +646,7 @@ impl Simulation {
         petsc: &Petsc,
         mesh: &mut LocalMesh,
         states: Vec<[GaussState; 3]>,
-    ) -> Result<StepReport, String> {
+    ) -> Result<StepReport, super::RunError> {
         let full = 1.0 / self.model.scene.steps.count as f64;
         let target = self.model.load_factor(self.header.step + 1);
         let mut from = self.header.load_factor;
@@ -690,15 +690,16 @@ impl Simulation {
                     cuts += 1;
                     piece *= 0.5;
                 }
-                Err(SolveError::Diverged(msg)) => {
-                    return Err(format!(
-                        "{msg}, on a piece of 1/{} of the step after {cuts} cuts (from load \
-                         factor {from:.6}); {}",
-                        (full / (to - from)).round(),
-                        super::sanity::divergence_advice(&self.model)
-                    ))
+                Err(SolveError::Diverged(message)) => {
+                    return Err(super::RunError::Diverged {
+                        message,
+                        piece: (full / (to - from)).round(),
+                        cuts,
+                        from,
+                        advice: super::sanity::divergence_advice(&self.model),
+                    })
                 }
-                Err(e) => return Err(e.to_string()),
+                Err(e) => return Err(super::RunError::Solve(e)),
             }
         }
     }

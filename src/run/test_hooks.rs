@@ -9,6 +9,7 @@
 //! - `PFEM_TEST_REPARTITION=rotate` repartitions after every step and hands every particle to
 //!   the next rank, so that the tests can check that a repartition changes no result.
 
+use super::RunError;
 use std::sync::OnceLock;
 
 const PHASES: [&str; 7] = [
@@ -29,8 +30,28 @@ struct Fault {
     step: u64,
 }
 
-fn parse(spec: &str) -> Result<Fault, String> {
-    let bad = |why: &str| format!("PFEM_INJECT_FAULT={spec}: {why} (RANK:PHASE:KIND[:STEP])");
+/// A `PFEM_INJECT_FAULT` that cannot be parsed, and why.
+#[derive(Debug, Clone)]
+pub struct FaultSpec {
+    spec: String,
+    why: String,
+}
+
+impl std::fmt::Display for FaultSpec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let FaultSpec { spec, why } = self;
+        write!(
+            f,
+            "PFEM_INJECT_FAULT={spec}: {why} (RANK:PHASE:KIND[:STEP])"
+        )
+    }
+}
+
+fn parse(spec: &str) -> Result<Fault, FaultSpec> {
+    let bad = |why: &str| FaultSpec {
+        spec: spec.to_string(),
+        why: why.to_string(),
+    };
     let parts: Vec<&str> = spec.split(':').collect();
     if !(3..=4).contains(&parts.len()) {
         return Err(bad("expected 3 or 4 fields"));
@@ -56,8 +77,8 @@ fn parse(spec: &str) -> Result<Fault, String> {
     })
 }
 
-fn fault() -> &'static Result<Option<Fault>, String> {
-    static FAULT: OnceLock<Result<Option<Fault>, String>> = OnceLock::new();
+fn fault() -> &'static Result<Option<Fault>, FaultSpec> {
+    static FAULT: OnceLock<Result<Option<Fault>, FaultSpec>> = OnceLock::new();
     FAULT.get_or_init(|| match std::env::var("PFEM_INJECT_FAULT") {
         Ok(spec) => parse(&spec).map(Some),
         Err(_) => Ok(None),
@@ -66,24 +87,25 @@ fn fault() -> &'static Result<Option<Fault>, String> {
 
 /// Not collective (that is the point): fails on the injected rank at the start of `phase` of
 /// `step` (the step being made), as `PFEM_INJECT_FAULT` asks.
-pub(super) fn inject(rank: i32, phase: &str, step: u64) -> Result<(), String> {
+pub(super) fn inject(rank: i32, phase: &str, step: u64) -> Result<(), RunError> {
     let f = match fault() {
         Ok(Some(f)) => f,
         Ok(None) => return Ok(()),
-        Err(e) => return Err(e.clone()),
+        Err(e) => return Err(e.clone().into()),
     };
     // Loading happens once, before any step.
     if f.rank != rank || f.phase != phase || (f.step != step && phase != "load") {
         return Ok(());
     }
-    let message = match phase {
-        "load" => format!("injected fault: load on rank {rank}"),
-        _ => format!("injected fault: {phase} of step {step} on rank {rank}"),
+    let error = RunError::InjectedFault {
+        phase: phase.to_string(),
+        step,
+        rank,
     };
     if f.panic {
-        panic!("{message}");
+        panic!("{error}");
     }
-    Err(message)
+    Err(error)
 }
 
 /// Whether `PFEM_TEST_REPARTITION=rotate` asks for a rotated repartition after every step.
@@ -106,9 +128,16 @@ mod tests {
         assert_eq!(parse("0:output:error:3").unwrap().step, 3);
         assert!(parse("1:mesh:error")
             .unwrap_err()
+            .to_string()
             .contains("PHASE is one of"));
-        assert!(parse("1:solve:crash").unwrap_err().contains("KIND"));
-        assert!(parse("x:solve:error").unwrap_err().contains("RANK"));
-        assert!(parse("1:solve").unwrap_err().contains("3 or 4"));
+        assert!(parse("1:solve:crash")
+            .unwrap_err()
+            .to_string()
+            .contains("KIND"));
+        assert!(parse("x:solve:error")
+            .unwrap_err()
+            .to_string()
+            .contains("RANK"));
+        assert!(parse("1:solve").unwrap_err().to_string().contains("3 or 4"));
     }
 }
