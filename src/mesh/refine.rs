@@ -123,10 +123,15 @@ pub fn plan(
             continue;
         }
         if protected(p) {
-            if let (Some(gap), [a, c]) = (support_gap(p), &along[p][..]) {
+            // Only a boundary particle between two boundary neighbours is asked for its gap
+            // (a closest-point query per body): most protected particles are not.
+            if let [a, c] = &along[p][..] {
+                let Some(gap) = support_gap(p) else {
+                    continue;
+                };
                 let crowded = [*a, *c].iter().any(|&q| {
-                    support_gap(q as usize).is_some_and(|g| g < gap)
-                        && dist(pu, q) < params.merge_distance * spacing(pu, q)
+                    dist(pu, q) < params.merge_distance * spacing(pu, q)
+                        && support_gap(q as usize).is_some_and(|g| g < gap)
                 });
                 if gap < params.merge_distance * h[p]
                     && crowded
