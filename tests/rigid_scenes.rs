@@ -158,7 +158,10 @@ fn pipeline_coarse_vertical_then_lateral() {
 fn staged_run_restarts_in_its_second_stage_on_another_rank_count() {
     let dir = workdir("pipeline-restart");
     new_pipeline(&dir);
-    ok(&dir, 2, &["p.h5", "--out", "whole"]);
+    // The checkpoint is written by 2 ranks in the lateral stage and continued on 1; the
+    // uninterrupted run is the 1-rank one, so the comparison measures what the checkpoint
+    // carries, not the two rank counts' own parting in the plastic flow (`pipeline_coarse_...`).
+    ok(&dir, 1, &["p.h5", "--out", "whole"]);
     ok(&dir, 2, &["p.h5", "--out", "split", "--until-step", "12"]);
     ok(
         &dir,
@@ -169,10 +172,8 @@ fn staged_run_restarts_in_its_second_stage_on_another_rank_count() {
         let whole = column(&dir, "whole", name);
         let split = column(&dir, "split", name);
         println!("{name}: whole {:?} split {:?}", &whole[12..], &split[12..]);
-        // Up to the checkpoint the restart is the run itself. After it, the lateral stage's cut
-        // steps amplify the rank-count round-off: 1.0e-3 at the first step, up to 1.3e-3 by
-        // step 16 (measured); the 1e-3 is not met yet.
-        close(&split[..12], &whole[..12], 1e-3);
-        close(&split[12..], &whole[12..], 3e-3);
+        // Measured: 1.2e-5 at the checkpoint (the ranks' round-off in the first 12 steps), at
+        // most 1.0e-4 after it.
+        close(&split, &whole, 1e-3);
     }
 }
