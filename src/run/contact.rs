@@ -84,7 +84,13 @@ impl Simulation {
             return out;
         }
         let young = model.scene.material.young;
-        let state = self.last_contact.borrow();
+        let carried = self.last_contact.borrow();
+        let none = super::contact::ContactState::new();
+        let state = if model.scene.contact.carry_state {
+            &*carried
+        } else {
+            &none
+        };
         for (bi, body) in model.bodies.iter().enumerate() {
             let shape = &out.bodies[bi];
             let shape_from = body.shape(from);
@@ -143,7 +149,7 @@ impl Simulation {
                         ];
                     }
                     let prox = shape.closest(x);
-                    if prox.distance > 0.25 * h {
+                    if prox.distance > 0.25 * h || !model.scene.contact.carry_state {
                         return [0.0; 2];
                     }
                     let sigma = |p: usize| {
@@ -176,6 +182,8 @@ impl Simulation {
                     } else {
                         0
                     },
+                    last_change: 0.0,
+                    raised: 0,
                 });
                 // Active when it touched at the end of the last increment, or when the body,
                 // where it will be, presses on the node where it is.

@@ -437,6 +437,9 @@ impl Simulation {
         // until they settle (every rank agrees through the reductions).
         let contact = &self.model.scene.contact;
         let mut augmentations = 0;
+        // A multiplier change below this (Pa) counts as settled for stiffening: a tenth of the
+        // tolerance at the last solve's largest pressure.
+        let mut settled = 0.0;
         let clock = std::time::Instant::now();
         if !self.model.bodies.is_empty()
             && sum_f64(world, &[problem.contact_pairs().len() as f64])[0] > 0.0
@@ -448,9 +451,10 @@ impl Simulation {
                 // Past half the allowed solves the active set is kept, so that nodes that keep
                 // entering and leaving it cannot stop the step.
                 let switch = 2 * (augmentations + 1) < contact.max_augmentations as usize;
-                let a = problem.augment(&local, spacing, switch);
+                let a = problem.augment(&local, spacing, switch, settled);
                 let change = max_f64(world, a.change);
                 let pressure = max_f64(world, a.pressure);
+                settled = 0.1 * contact.tolerance * pressure;
                 let switched = sum_f64(world, &[a.switched as f64])[0];
                 if switched == 0.0 && change <= contact.tolerance * pressure {
                     break;

@@ -91,6 +91,11 @@ pub struct Contact {
     pub tolerance: f64,
     /// Most Newton solves per increment (the first plus augmentations). Default 12.
     pub max_augmentations: u32,
+    /// Start every increment from the contact pressures and shears of the last one, carried
+    /// across the remesh by node identity, and a node new to the contact from the soil's
+    /// normal stress there. Default true; false starts every increment from no contact
+    /// pressure at all: for measuring what carrying the state saves (bench/VALIDATION.md).
+    pub carry_state: bool,
 }
 
 impl Default for Contact {
@@ -99,6 +104,7 @@ impl Default for Contact {
             penalty: 1000.0,
             tolerance: 1e-6,
             max_augmentations: 12,
+            carry_state: true,
         }
     }
 }

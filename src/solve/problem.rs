@@ -351,12 +351,22 @@ impl<'a> StepProblem<'a> {
     /// spacing, to report the penetration relative to it.
     /// With `switch` false the active set is kept (only the multipliers change): the last
     /// resort when nodes keep entering and leaving it.
-    pub fn augment(&mut self, local: &[f64], spacing: &[f64], switch: bool) -> Augmentation {
+    /// `settled` (Pa) is the change below which a multiplier counts as settled
+    /// ([`ContactPair::stiffen_if_stalled`]).
+    pub fn augment(
+        &mut self,
+        local: &[f64],
+        spacing: &[f64],
+        switch: bool,
+        settled: f64,
+    ) -> Augmentation {
         let forces = self.contact_forces(local);
         let mut a = Augmentation::default();
         for ((c, f), h) in self.setup.contact.iter_mut().zip(&forces).zip(spacing) {
             let p = f.pressure.max(-c.suction);
-            a.change = a.change.max((p - c.multiplier).abs());
+            let change = (p - c.multiplier).abs();
+            a.change = a.change.max(change);
+            c.stiffen_if_stalled(change, settled);
             a.pressure = a.pressure.max(p + c.suction);
             a.penetration = a.penetration.max(-f.gap / h);
             let active = f.pressure > -c.suction;
