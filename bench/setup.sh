@@ -3,6 +3,8 @@
 # target/bench/NAME; `$bin` is the binary.
 set -euo pipefail
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+# Concurrent jobs (tests, studies) would all pin their rank 0 to core 0: let the kernel place ranks.
+export OMPI_MCA_hwloc_base_binding_policy=none
 cargo build --release -q
 bin=$PWD/target/release/pfem-mpi
 work=target/bench/$1

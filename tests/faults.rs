@@ -293,7 +293,16 @@ fn a_damaged_scene_attribute_is_an_error_not_a_panic() {
 /// stderr, seconds), failing the test if the job is not over within 30 s.
 fn injected(dir: &Path, spec: &str) -> (bool, String, f64) {
     let mut child = Command::new("mpirun")
-        .args(["-n", "2", "--oversubscribe", bin(), "c.h5", "--out"])
+        .args([
+            "-n",
+            "2",
+            "--oversubscribe",
+            "--bind-to",
+            "none",
+            bin(),
+            "c.h5",
+            "--out",
+        ])
         .arg(format!("out-{}", spec.replace(':', "-")))
         .current_dir(dir)
         .env("OMPI_ALLOW_RUN_AS_ROOT", "1")

@@ -19,7 +19,14 @@ fn run_limited(dir: &Path, ranks: usize, args: &[&str]) -> (bool, Option<i32>, S
         Command::new(bin())
     } else {
         let mut c = Command::new("mpirun");
-        c.args(["-n", &ranks.to_string(), "--oversubscribe", bin()]);
+        c.args([
+            "-n",
+            &ranks.to_string(),
+            "--oversubscribe",
+            "--bind-to",
+            "none",
+            bin(),
+        ]);
         c
     };
     let mut child = cmd

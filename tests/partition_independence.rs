@@ -50,6 +50,8 @@ fn run_case(
         "-n",
         &ranks.to_string(),
         "--oversubscribe",
+        "--bind-to",
+        "none",
         bin(),
         case,
         "--out",

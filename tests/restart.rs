@@ -73,7 +73,14 @@ fn spawn(dir: &Path, mpi_ranks: Option<usize>, args: &[&str]) -> std::process::C
         None => Command::new(bin()),
         Some(n) => {
             let mut c = Command::new("mpirun");
-            c.args(["-n", &n.to_string(), "--oversubscribe", bin()]);
+            c.args([
+                "-n",
+                &n.to_string(),
+                "--oversubscribe",
+                "--bind-to",
+                "none",
+                bin(),
+            ]);
             c
         }
     };

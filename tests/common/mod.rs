@@ -33,7 +33,14 @@ pub fn run(dir: &Path, ranks: usize, args: &[&str]) -> Output {
         Command::new(bin())
     } else {
         let mut c = Command::new("mpirun");
-        c.args(["-n", &ranks.to_string(), "--oversubscribe", bin()]);
+        c.args([
+            "-n",
+            &ranks.to_string(),
+            "--oversubscribe",
+            "--bind-to",
+            "none",
+            bin(),
+        ]);
         c
     };
     cmd.args(args)
