@@ -117,7 +117,11 @@ fn drive(
         progress.step(sim, &report, &t);
         // Measured once, on the last mesh: the same condition on every rank (`last` is agreed).
         if sim.step() >= last {
-            sizes = Some(rank_table::RankSizes::measure(world, &mesh, sim.model.mixed())?);
+            sizes = Some(rank_table::RankSizes::measure(
+                world,
+                &mesh,
+                sim.model.mixed(),
+            )?);
         }
     }
     progress.finish(sim);
