@@ -4,6 +4,7 @@ mod contact;
 mod error;
 mod output;
 mod progress;
+mod rank_table;
 mod refinement;
 mod restart;
 mod sanity;
@@ -78,6 +79,9 @@ fn drive(
     let mut out = output::Output::open(world, sim, &opts.out_dir)?;
     let mut progress = Progress::new(world, sim.total_steps());
     let mut last = opts.until_step.unwrap_or(u64::MAX).min(sim.total_steps());
+    // The per-rank table after the end-of-run line: sizes of the last mesh, CPU of the solves.
+    let mut sizes = None;
+    let mut solve_cpu = 0.0;
     while sim.step() < last {
         let mut t = PhaseTimer::default();
         let next = sim.step() + 1;
@@ -87,10 +91,12 @@ fn drive(
         })?;
         fault("map", next)?;
         let states = t.time("map", || sim.map(&mesh));
+        let cpu = rank_table::cpu_seconds();
         let report = t.time("solve", || {
             fault("solve", next)?;
             sim.advance(world, petsc, &mut mesh, states)
         })?;
+        solve_cpu += rank_table::cpu_seconds() - cpu;
         sanity::check_step(world, sim, &mesh, &report)?;
         if stop.requested(world) {
             last = sim.step();
@@ -109,7 +115,18 @@ fn drive(
             sim.rebalance_if_needed(world)
         })?;
         progress.step(sim, &report, &t);
+        // Measured once, on the last mesh: the same condition on every rank (`last` is agreed).
+        if sim.step() >= last {
+            sizes = Some(rank_table::RankSizes::measure(
+                world,
+                &mesh,
+                sim.model.mixed(),
+            )?);
+        }
     }
     progress.finish(sim);
+    if let Some(sizes) = &sizes {
+        rank_table::print(world, sizes, solve_cpu);
+    }
     out.plot(world)
 }
