@@ -1,0 +1,134 @@
+#!/usr/bin/env bash
+# Run time against error for one built-in scene (issue 10, item 5): sweeps the spacing (`mesh.h`
+# and every `mesh.fine` region's spacing scaled by the same factor; 1 is the built-in mesh) and the
+# step count, on 1 and 2 ranks, with both linear solver paths (`solver.linear = "direct"` and
+# `"iterative"`), and writes bench/results/SCENE.md (a Markdown table: spacing, steps, particles,
+# ranks, path, wall s, CPU s summed over the ranks from /usr/bin/time, Newton and linear
+# iterations, the scene's figure, its error, the status) and bench/results/SCENE.png (error
+# against CPU s and wall s, log-log, one marker per ranks x path, the Pareto front joined), plus
+# the recommended setting: the cheapest run (CPU s) within 1 % of the reference. Raw rows go to
+# bench/results/SCENE.csv and are merged by (factor, steps, ranks, path), so a later invocation
+# with other FACTORS or STEPS adds to the same table.
+#
+# Errors (bench/error_vs_time.py, `measure`):
+#   cantilever         v/L and u/L at lambda = 10 against the plane-strain Reissner 0.8175 / 0.548
+#                      (the continuum itself sits about 0.5 % off the beam: README)
+#   footing-shallow    q/cu at the last step (z/B = 0.003) against 2 + pi
+#   block-compression  |stress/cu - 2| / 2 over the yielded steps and |volume ratio - 1|
+#   tbar-smooth/-rough mean Nc over w = 0.1D..0.25D of a 0.25D push against 9.142 / 11.940
+#   footing            q/cu at z/B = 0.1 (a 0.2 m push), against a Richardson value from the sweep
+#   pipeline           V/(D cu) at w = 0.25D (a 0.01 m push), against a Richardson value from the sweep
+# Every run is under `nice -n 10` and a `timeout` (TIMEOUT s of wall). Once the iterative path
+# fails on a rank count, its more expensive settings are recorded as not run. A run stopped by
+# the solver is recorded with its reason; its error is not counted.
+#
+# Usage: bench/error_vs_time.sh SCENE
+#   environment: FACTORS="2 1" STEPS="10 20" RANKS="1 2" PATHS="direct iterative"
+#                TIMEOUT=600 (s per run) BUDGET=3600 (s for the sweep; later runs recorded as not run)
+#
+# The tables and PNGs in bench/results/ were made with (2-core machine shared with other long
+# jobs; CPU s are the reliable cost, wall s are inflated):
+#   bench/error_vs_time.sh cantilever
+#   bench/error_vs_time.sh block-compression
+#   bench/error_vs_time.sh footing-shallow
+#   bench/error_vs_time.sh tbar-smooth
+#   bench/error_vs_time.sh tbar-rough
+#   bench/error_vs_time.sh footing
+#   bench/error_vs_time.sh pipeline
+# (the exact FACTORS/STEPS/RANKS/PATHS of each are in its table's header line)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$PWD
+scene=${1:?usage: bench/error_vs_time.sh SCENE}
+helper=$root/bench/error_vs_time.py
+results=$root/bench/results
+mkdir -p "$results"
+python3 -c 'import matplotlib' 2>/dev/null ||
+  pip3 install -q matplotlib || pip3 install -q --break-system-packages matplotlib
+
+# Per scene: spacing factors (coarse first), step counts, time limit of one run.
+case $scene in
+  cantilever) factors="2 1 0.5" steps="10 20 50" timeout=900 ;;
+  block-compression) factors="2 1 0.5" steps="50 100" timeout=600 ;;
+  footing-shallow) factors="4 2 1" steps="15 30" timeout=900 ;;
+  tbar-smooth | tbar-rough) factors="2 1" steps="10 25" timeout=1200 ;;
+  footing) factors="2 1" steps="10 20" timeout=1200 ;;
+  pipeline) factors="2 1" steps="10 25" timeout=1200 ;;
+  *) echo "unknown scene $scene" >&2 && exit 2 ;;
+esac
+factors=${FACTORS:-$factors}
+steps=${STEPS:-$steps}
+ranks_list=${RANKS:-1 2}
+paths=${PATHS:-direct iterative}
+timeout=${TIMEOUT:-$timeout}
+budget=${BUDGET:-3600}
+csv=$results/$scene.csv
+
+source bench/setup.sh "error_vs_time_$scene"
+start=$(date +%s)
+failed_iterative=" "
+echo "$scene: factors $factors, steps $steps, ranks $ranks_list, paths $paths (timeout $timeout s, budget $budget s)"
+echo "FACTORS=\"$factors\" STEPS=\"$steps\" RANKS=\"$ranks_list\" PATHS=\"$paths\" bench/error_vs_time.sh $scene" \
+  >>"$results/$scene.commands"
+
+for f in $factors; do
+  mapfile -t mesh < <(python3 "$helper" mesh "$scene" "$f")
+  hmin=$(python3 "$helper" hmin "$scene" "$f")
+  for n in $steps; do
+    mapfile -t push < <(python3 "$helper" push "$scene" "$n")
+    for path in $paths; do
+      name="f${f}_n${n}_$path"
+      sets=(--set "solver.linear=\"$path\"")
+      for s in "${mesh[@]}" "${push[@]}"; do sets+=(--set "$s"); done
+      "$bin" new "$scene" -o "$name.h5" "${sets[@]}" >/dev/null
+      particles=$("$bin" info "$name.h5" | awk '/^particles/ {print $2}')
+      for ranks in $ranks_list; do
+        run="${name}_r$ranks"
+        common=(scene="$scene" factor="$f" h_min="$hmin" steps="$n" particles="$particles"
+          ranks="$ranks" path="$path")
+        if (($(date +%s) - start > budget)); then
+          python3 "$helper" record "$csv" "${common[@]}" status="not run (time budget)"
+          continue
+        fi
+        if [[ $path == iterative && $failed_iterative == *" $ranks "* ]]; then
+          python3 "$helper" record "$csv" "${common[@]}" \
+            status="not run (the iterative path failed at a cheaper setting)"
+          continue
+        fi
+        echo "  $run ($particles particles)"
+        t0=$(date +%s.%N)
+        code=0
+        # Each rank under /usr/bin/time: user + system CPU s and peak RSS per rank.
+        nice -n 10 timeout -k 30 "$timeout" mpirun -n "$ranks" sh -c \
+          'exec /usr/bin/time -f "%U %S %M" -o "$0.time.$OMPI_COMM_WORLD_RANK" "$@"' "$run" \
+          "$bin" "$name.h5" --out "$run.out" >"$run.log" 2>&1 || code=$?
+        t1=$(date +%s.%N)
+        wall=$(echo "$t1 - $t0" | bc)
+        cpu=$(cat "$run".time.* 2>/dev/null | awk '$1 ~ /^[0-9.]+$/ { c += $1 + $2; if ($3 > m) m = $3 }
+          END { if (NR) printf "%.2f %.0f", c, m / 1024 }' || true)
+        read -r cpu_s rss_mb <<<"${cpu:-- -}"
+        done_line=$(grep -m1 '^done:' "$run.log" || true)
+        newton=$(grep -o '[0-9]* Newton iterations' <<<"$done_line" | cut -d' ' -f1 || true)
+        linear=$(grep -o '[0-9]* linear iterations' <<<"$done_line" | cut -d' ' -f1 || true)
+        last=$(tail -1 "$run.out/history.csv" 2>/dev/null | cut -d, -f1 || true)
+        if ((code == 0)) && [[ $last == "$n" ]]; then
+          status=ok
+        elif ((code == 124 || code == 137)); then
+          status="timeout after $timeout s"
+        else
+          why=$(grep -m1 -i -E 'error|did not|stalled|diverged' "$run.log" | tr -d '|' | cut -c1-160 || true)
+          status="failed (exit $code): ${why:-see $run.log}"
+        fi
+        if [[ $status != ok && $path == iterative ]]; then
+          failed_iterative+="$ranks "
+        fi
+        python3 "$helper" record "$csv" "${common[@]}" status="$status" wall_s="$wall" \
+          cpu_s="${cpu_s/-/}" rss_mb="${rss_mb/-/}" newton_its="$newton" linear_its="$linear" \
+          history="$run.out/history.csv"
+        printf '    %s: wall %.1f s, CPU %s s, %s Newton its\n' "$status" "$wall" "${cpu_s}" "${newton:--}"
+      done
+    done
+  done
+done
+python3 "$helper" report "$scene" "$csv" "$results/$scene"
+echo "wrote $results/$scene.md, $results/$scene.png"
