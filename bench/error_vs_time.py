@@ -6,6 +6,7 @@ by, and the per-scene table (Markdown) and error-against-time plot (PNG).
   error_vs_time.py push SCENE STEPS       --set arguments (one a line) for STEPS steps
   error_vs_time.py record CSV KEY=VALUE.. measure one finished run and merge its row into CSV
   error_vs_time.py report SCENE CSV OUT   write OUT.md and OUT.png from CSV
+  error_vs_time.py iterative-failed CSV RANKS   exit 0 if the iterative path failed on RANKS
 
 FACTOR scales `mesh.h` and every `mesh.fine` region's spacing (regions keep their place, so the
 grading is the built-in's); 1 is the built-in mesh.
@@ -13,6 +14,7 @@ grading is the built-in's); 1 is the built-in mesh.
 import csv
 import math
 import os
+import shlex
 import sys
 
 PI = math.pi
@@ -258,8 +260,10 @@ def report(scene, path, out):
         lines += [ref_text + " The shallow push is the only depth the sweep reaches; a reference "
                   "extrapolated from the sweep makes its finest runs look better than they are.", ""]
     lines += ["CPU s is user + system time summed over the ranks (`/usr/bin/time` around each rank): "
-              "the reliable cost. Wall times are inflated: every run was under `nice -n 10` on a "
-              "2-core machine that other long jobs shared all the while.", "",
+              "the reliable cost (on 2 ranks it includes the time a rank spins in MPI waiting for the "
+              "other, so it overstates the work). Wall times (mpirun to exit, including about 1 s of "
+              "start-up) are inflated: every run was under `nice -n 10` on a 2-core machine that "
+              "other long jobs shared all the while.", "",
               f"| spacing factor | finest h (m) | steps | particles | ranks | path | wall s | CPU s | "
               f"Newton its | linear its | {name} | {name2} | error | status |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -281,12 +285,16 @@ def report(scene, path, out):
     lines.append("")
     if good:
         b = min(good, key=lambda r: float(r["cpu_s"]))
+        cmd = " ".join(shlex.quote(a) for a in
+                       ["pfem-mpi", "new", scene, "-o", "case.h5"]
+                       + [x for st in mesh_sets(scene, float(b["factor"])) + push_sets(scene, int(b["steps"]))
+                          + [f'solver.linear="{b["path"]}"'] for x in ("--set", st)])
         lines.append(
             f"**Recommended setting** (the cheapest run in CPU seconds within 1 % of the reference): "
-            f"spacing factor {float(b['factor']):g} (finest h = {float(b['h_min']):.4g} m, "
-            f"`{' '.join('--set ' + repr(s) if '[' in s else '--set ' + s for s in mesh_sets(scene, float(b['factor'])))}`), "
-            f"{b['steps']} steps, {b['ranks']} rank(s), {b['path']} solver: "
-            f"{float(b['cpu_s']):.1f} CPU s, error {100 * float(b['error']):.3g} %.")
+            f"spacing factor {float(b['factor']):g} (finest h = {float(b['h_min']):.4g} m), "
+            f"{b['steps']} steps, {b['ranks']} rank{'s' if b['ranks'] != '1' else ''}, {b['path']} solver: "
+            f"{float(b['cpu_s']):.1f} CPU s, error {100 * float(b['error']):.3g} %:")
+        lines += ["", f"    {cmd}", f"    mpirun -n {b['ranks']} pfem-mpi case.h5"]
     else:
         lines.append("**Recommended setting**: none of the runs is within 1 % of the reference.")
     with open(out + ".md", "w") as f:
@@ -343,6 +351,11 @@ def main():
         print("\n".join(push_sets(sys.argv[2], int(sys.argv[3]))))
     elif cmd == "record":
         record(sys.argv[2], sys.argv[3:])
+    elif cmd == "iterative-failed":
+        # Exit 0 when the iterative path failed (or timed out) on this rank count before.
+        bad = [r for r in read_rows(sys.argv[2]) if r["path"] == "iterative" and r["ranks"] == sys.argv[3]
+               and (r["status"].startswith("failed") or r["status"].startswith("timeout"))]
+        sys.exit(0 if bad else 1)
     elif cmd == "report":
         report(sys.argv[2], sys.argv[3], sys.argv[4])
     else:
