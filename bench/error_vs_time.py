@@ -115,7 +115,9 @@ def measure(scene, rows):
         yielded = [r for r in rows if int(r["step"]) >= 2] or rows
         worst = max((float(r["stress_over_cu"]) - 2 for r in yielded), key=abs)
         vol = max((float(r["volume_ratio"]) - 1 for r in rows), key=abs)
-        err = max(abs(worst) / 2, abs(vol))
+        # The exact volume ratio once yielded is the elastic 1 - p/K, p = cu, K = E / (3 (1 - 2 nu)).
+        elastic = 1 - 10.0e3 / (3.0e6 / (3 * (1 - 2 * 0.49)))
+        err = max(abs(worst) / 2, max(abs(float(r["volume_ratio"]) - elastic) for r in yielded))
         return worst, vol, err, f"strain {float(last['strain']):.3g}"
     if scene in ("tbar-smooth", "tbar-rough"):
         tail = [float(r["Nc"]) for r in rows if float(r["w_over_D"]) >= 0.1 - 1e-9]
@@ -223,9 +225,10 @@ LABEL = {
     "footing-shallow": ("q/cu at the last step", "z/B", "|q/cu / (2 + π) − 1| at the last step "
                         "(z/B = 0.003; Prandtl, reference.md §2)"),
     "block-compression": ("worst stress/cu − 2 (yielded)", "worst volume ratio − 1",
-                          "max(|stress/cu − 2| / 2 over the yielded steps, |volume ratio − 1| over all "
-                          "steps) to 50 % strain; the volume ratio's elastic 1 − p/K = 1 − 2.0e-4 is "
-                          "part of the exact answer"),
+                          "max(|stress/cu − 2| / 2, |volume ratio − (1 − p/K)|) over the yielded steps "
+                          "(step 2 on) to 50 % strain, 1 − p/K = 1 − 2.0e-4 being the exact (elastic) "
+                          "volume change once yielded; the table's volume column is the worst departure "
+                          "from 1 over all steps"),
     "tbar-smooth": ("mean Nc, w = 0.1D–0.25D", "w/D reached", "|mean Nc / 9.142 − 1| over the steps "
                     "with w ≥ 0.1D of a 0.25D push (exact deep-flow value, reference.md §3)"),
     "tbar-rough": ("mean Nc, w = 0.1D–0.25D", "w/D reached", "|mean Nc / 11.940 − 1| over the steps "
@@ -245,8 +248,14 @@ def report(scene, path, out):
         for r in rows:
             if r["status"] == "ok" and r["value"] != "" and ref is not None:
                 r["error"] = fmt(abs(float(r["value"]) / ref - 1))
-        if ref is not None:
-            ref_text = f"Reference value {ref:.5g}: {ref_text}."
+        ref_text = f"Reference value {ref:.5g}: {ref_text}." if ref is not None else ref_text + "."
+    if scene == "block-compression":
+        # Rows recorded before the volume was judged against 1 - p/K: recompute from the columns
+        # (the worst volume departure lies in the yielded steps).
+        elastic = 1 - 10.0e3 / (3.0e6 / (3 * (1 - 2 * 0.49)))
+        for r in rows:
+            if r["status"] == "ok" and r["value"] != "":
+                r["error"] = fmt(max(abs(float(r["value"])) / 2, abs(1 + float(r["value2"]) - elastic)))
     rows.sort(key=lambda r: (-float(r["factor"]), int(r["steps"]), int(r["ranks"]), r["path"]))
     name, name2, err_text = LABEL[scene]
     lines = [f"# Error against run time: `{scene}`", "",

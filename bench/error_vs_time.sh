@@ -26,6 +26,7 @@
 # Usage: bench/error_vs_time.sh SCENE
 #   environment: FACTORS="2 1" STEPS="10 20" RANKS="1 2" PATHS="direct iterative"
 #                TIMEOUT=600 (s per run) BUDGET=3600 (s for the sweep; later runs recorded as not run)
+#                WORK_TAG=NAME (own work folder; concurrent invocations share the CSV under flock)
 #                DEADLINE=EPOCH_S (no run starts with less than 120 s to go, none runs past it)
 #
 # The tables and PNGs in bench/results/ were made with (2-core machine shared with other long
@@ -69,7 +70,8 @@ budget=${BUDGET:-3600}
 deadline=${DEADLINE:-0}
 csv=$results/$scene.csv
 
-source bench/setup.sh "error_vs_time_$scene"
+# WORK_TAG keeps the work folders of concurrent invocations for one scene apart.
+source bench/setup.sh "error_vs_time_$scene${WORK_TAG:+_$WORK_TAG}"
 start=$(date +%s)
 failed_iterative=" "
 echo "$scene: factors $factors, steps $steps, ranks $ranks_list, paths $paths (timeout $timeout s, budget $budget s)"
@@ -94,25 +96,25 @@ for f in $factors; do
         common=(scene="$scene" factor="$f" h_min="$hmin" steps="$n" particles="$particles"
           ranks="$ranks" path="$path")
         if [[ -n $refused ]]; then
-          python3 "$helper" record "$csv" "${common[@]}" status="case refused: $refused"
+          flock "$csv.lock" python3 "$helper" record "$csv" "${common[@]}" status="case refused: $refused"
           continue
         fi
         if (($(date +%s) - start > budget)); then
-          python3 "$helper" record "$csv" "${common[@]}" status="not run (time budget)"
+          flock "$csv.lock" python3 "$helper" record "$csv" "${common[@]}" status="not run (time budget)"
           continue
         fi
         limit=$timeout
         if ((deadline > 0)); then
           left=$((deadline - $(date +%s)))
           if ((left < 120)); then
-            python3 "$helper" record "$csv" "${common[@]}" status="not run (time budget)"
+            flock "$csv.lock" python3 "$helper" record "$csv" "${common[@]}" status="not run (time budget)"
             continue
           fi
           if ((left < limit)); then limit=$left; fi
         fi
         if [[ $path == iterative ]] && { [[ $failed_iterative == *" $ranks "* ]] ||
           python3 "$helper" iterative-failed "$csv" "$ranks"; }; then
-          python3 "$helper" record "$csv" "${common[@]}" \
+          flock "$csv.lock" python3 "$helper" record "$csv" "${common[@]}" \
             status="not run (the iterative path failed at a cheaper setting)"
           continue
         fi
@@ -143,7 +145,7 @@ for f in $factors; do
         if [[ $status != ok && $path == iterative ]]; then
           failed_iterative+="$ranks "
         fi
-        python3 "$helper" record "$csv" "${common[@]}" status="$status" wall_s="$wall" \
+        flock "$csv.lock" python3 "$helper" record "$csv" "${common[@]}" status="$status" wall_s="$wall" \
           cpu_s="${cpu_s/-/}" rss_mb="${rss_mb/-/}" newton_its="$newton" linear_its="$linear" \
           history="$run.out/history.csv"
         printf '    %s: wall %.1f s, CPU %s s, %s Newton its\n' "$status" "$wall" "${cpu_s}" "${newton:--}"
@@ -151,5 +153,5 @@ for f in $factors; do
     done
   done
 done
-python3 "$helper" report "$scene" "$csv" "$results/$scene"
+flock "$csv.lock" python3 "$helper" report "$scene" "$csv" "$results/$scene"
 echo "wrote $results/$scene.md, $results/$scene.png"
