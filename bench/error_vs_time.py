@@ -265,6 +265,10 @@ def report(scene, path, out):
     if os.path.exists(cmds):
         lines += ["Invocations that made these rows (from the repository root):", ""]
         lines += ["    " + c for c in dict.fromkeys(open(cmds).read().splitlines())] + [""]
+        lines += ["Some of these were stopped before their end to keep the session's time (those runs "
+                  "have no row; a row `not run (time budget)` is a run the time limit left out), and most "
+                  "had `TIMEOUT` and `DEADLINE` set: a run the limit cut is marked `timeout`, with the "
+                  "step it reached. Such timeouts measure the shared machine, not the solver.", ""]
     if ref_text:
         lines += [ref_text + " The shallow push is the only depth the sweep reaches; a reference "
                   "extrapolated from the sweep makes its finest runs look better than they are.", ""]
@@ -333,7 +337,8 @@ def plot(scene, rows, png, name):
                    and r[col]]
             if bad:
                 ax.scatter([float(r[col]) for r in bad], [top] * len(bad), marker="x", color=c, zorder=3,
-                           label=f"{ranks} rank{'s' if ranks != '1' else ''}, {path}: failed (plotted at the top)")
+                           label=f"{ranks} rank{'s' if ranks != '1' else ''}, {path}: failed or timed out (at the top; "
+                                 f"no CPU s when killed)")
         pts = [(float(r[col]), max(float(r["error"]), 1e-13)) for r in ok]
         front = pareto(pts)
         if front:
@@ -344,7 +349,11 @@ def plot(scene, rows, png, name):
         ax.set_xlabel(xlabel)
         ax.grid(True, which="both", lw=0.3)
     axes[0].set_ylabel("relative error")
-    axes[0].legend(fontsize=7, loc="best")
+    handles = {}
+    for ax in axes:
+        for h, l in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(l, h)
+    axes[0].legend(handles.values(), handles.keys(), fontsize=7, loc="best")
     fig.suptitle(f"{scene}: error ({name}) against run time")
     fig.tight_layout()
     fig.savefig(png, dpi=110)

@@ -14,7 +14,7 @@
 #   cantilever         v/L and u/L at lambda = 10 against the plane-strain Reissner 0.8175 / 0.548
 #                      (the continuum itself sits about 0.5 % off the beam: README)
 #   footing-shallow    q/cu at the last step (z/B = 0.003) against 2 + pi
-#   block-compression  |stress/cu - 2| / 2 over the yielded steps and |volume ratio - 1|
+#   block-compression  |stress/cu - 2| / 2 and |volume ratio - (1 - p/K)| over the yielded steps
 #   tbar-smooth/-rough mean Nc over w = 0.1D..0.25D of a 0.25D push against 9.142 / 11.940
 #   footing            q/cu at z/B = 0.1 (a 0.2 m push), against a Richardson value from the sweep
 #   pipeline           V/(D cu) at w = 0.25D (a 0.01 m push), against a Richardson value from the sweep
@@ -29,16 +29,19 @@
 #                WORK_TAG=NAME (own work folder; concurrent invocations share the CSV under flock)
 #                DEADLINE=EPOCH_S (no run starts with less than 120 s to go, none runs past it)
 #
-# The tables and PNGs in bench/results/ were made with (2-core machine shared with other long
-# jobs; CPU s are the reliable cost, wall s are inflated):
+# The tables and PNGs in bench/results/ were made on the 2-core development machine while other
+# long jobs shared it (load average 8-23; CPU s are the reliable cost, wall s are inflated), with
+# DEADLINE set to the session's end and TIMEOUT raised for the 1-rank runs of the larger meshes, by
+# the invocations listed in each bench/results/SCENE.commands (and in SCENE.md), e.g.
 #   bench/error_vs_time.sh cantilever
-#   bench/error_vs_time.sh block-compression
-#   bench/error_vs_time.sh footing-shallow
-#   bench/error_vs_time.sh tbar-smooth
-#   bench/error_vs_time.sh tbar-rough
-#   bench/error_vs_time.sh footing
-#   bench/error_vs_time.sh pipeline
-# (the exact FACTORS/STEPS/RANKS/PATHS of each are in its table's header line)
+#   FACTORS="2.5 1.25 1 0.5" STEPS="50 100" bench/error_vs_time.sh block-compression
+#   FACTORS="4 2 1" STEPS="15 30" bench/error_vs_time.sh footing-shallow
+#   FACTORS="2" STEPS="10 25" bench/error_vs_time.sh tbar-smooth
+#   FACTORS="1" STEPS="25" RANKS=1 PATHS=direct TIMEOUT=2400 bench/error_vs_time.sh tbar-smooth
+#   FACTORS="2 1" STEPS="20" RANKS=1 PATHS=direct bench/error_vs_time.sh footing
+#   FACTORS="2 1" STEPS="25" RANKS=1 PATHS=direct bench/error_vs_time.sh pipeline
+# Then `python3 bench/error_vs_time.py report SCENE bench/results/SCENE.csv bench/results/SCENE`
+# redraws a table and plot from the CSV alone.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
