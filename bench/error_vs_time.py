@@ -121,6 +121,8 @@ def measure(scene, rows):
         return worst, vol, err, f"strain {float(last['strain']):.3g}"
     if scene in ("tbar-smooth", "tbar-rough"):
         tail = [float(r["Nc"]) for r in rows if float(r["w_over_D"]) >= 0.1 - 1e-9]
+        if not tail:  # stopped before w = 0.1D: the last Nc, no error
+            return float(last["Nc"]), float(last["w_over_D"]), None, f"Nc {float(last['Nc']):.3f} at w/D {float(last['w_over_D']):.3g}"
         nc = sum(tail) / len(tail)
         return nc, float(last["w_over_D"]), abs(nc / EXACT[scene] - 1), \
             f"mean of {len(tail)} steps, w/D 0.1-{float(last['w_over_D']):.3g}, Nc {min(tail):.3f}-{max(tail):.3f}"
