@@ -371,6 +371,24 @@ def main():
         print("\n".join(push_sets(sys.argv[2], int(sys.argv[3]))))
     elif cmd == "record":
         record(sys.argv[2], sys.argv[3:])
+    elif cmd == "summary":
+        # bench/results/README.md: each scene's recommended setting, from its SCENE.md.
+        out = sys.argv[2]
+        lines = ["# Run time against error: measured fronts", "",
+                 "Made by `bench/error_vs_time.sh SCENE` (issue 10, item 5); per scene a table "
+                 "(`SCENE.md`), a plot (`SCENE.png`, error against CPU s and wall s) and the raw rows "
+                 "(`SCENE.csv`). Measured on the 2-core development machine while other long jobs "
+                 "shared it: CPU s are the reliable cost, wall s are inflated.", ""]
+        for scene in MESHES:
+            md = os.path.join(os.path.dirname(out), scene + ".md")
+            if not os.path.exists(md):
+                continue
+            text = open(md).read().splitlines()
+            rec = [i for i, l in enumerate(text) if l.startswith("**Recommended setting**")]
+            lines += [f"## {scene}", ""]
+            if rec:
+                lines += text[rec[0]:] + [""]
+        open(out, "w").write("\n".join(lines) + "\n")
     elif cmd == "iterative-failed":
         # Exit 0 when the iterative path failed (or timed out) on this rank count before.
         bad = [r for r in read_rows(sys.argv[2]) if r["path"] == "iterative" and r["ranks"] == sys.argv[3]
