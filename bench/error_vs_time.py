@@ -176,12 +176,18 @@ def record(path, args):
 
 
 def richardson(rows):
-    """Reference from the sweep itself: per spacing factor the direct run with the most steps
-    (1 rank preferred), extrapolated in the spacing. Returns (value, text)."""
+    """Reference from the sweep itself: the direct runs of one step count (the largest that most
+    spacings finished; 1 rank preferred), extrapolated in the spacing. Returns (value, text)."""
     best = {}
-    for r in rows:
-        if r["status"] != "ok" or r["path"] != "direct" or r["value"] == "":
-            continue
+    ok = [r for r in rows if r["status"] == "ok" and r["path"] == "direct" and r["value"] != ""]
+    # One step count for every spacing: the largest that the most spacings finished.
+    counts = {}
+    for r in ok:
+        counts.setdefault(int(r["steps"]), set()).add(r["factor"])
+    if counts:
+        n = max(counts, key=lambda k: (len(counts[k]), k))
+        ok = [r for r in ok if int(r["steps"]) == n]
+    for r in ok:
         f = float(r["factor"])
         rank_pref = (int(r["steps"]), -int(r["ranks"]))
         if f not in best or rank_pref > best[f][0]:
@@ -205,6 +211,7 @@ def richardson(rows):
         else:
             how = "order 1 assumed (the three spacings do not converge monotonically)"
     ref = q0 + (q0 - q1) / (ratio ** p - 1)
+    how += f"; the extrapolation moves the finest value by {100 * abs(ref / q0 - 1):.2g} %"
     used = ", ".join(f"factor {f:g}: {best[f][1]:.5g} ({best[f][2]['steps']} steps, {best[f][2]['ranks']} rank(s))"
                      for f in fs)
     return ref, f"Richardson extrapolation in the spacing, {how}; from {used}"
@@ -272,8 +279,9 @@ def report(scene, path, out):
                   "had `TIMEOUT` and `DEADLINE` set: a run the limit cut is marked `timeout`, with the "
                   "step it reached. Such timeouts measure the shared machine, not the solver.", ""]
     if ref_text:
-        lines += [ref_text + " The shallow push is the only depth the sweep reaches; a reference "
-                  "extrapolated from the sweep makes its finest runs look better than they are.", ""]
+        lines += [ref_text + " Short pushes only: the reference is for this shallow depth, not for the "
+                  "scene's full run; it is only as good as the sweep (with two spacings the order is "
+                  "assumed, and a long extrapolation is uncertain by about its own length).", ""]
     lines += ["CPU s is user + system time summed over the ranks (`/usr/bin/time` around each rank): "
               "the reliable cost (on 2 ranks it includes the time a rank spins in MPI waiting for the "
               "other, so it overstates the work). Wall times (mpirun to exit, including about 1 s of "
@@ -356,7 +364,7 @@ def plot(scene, rows, png, name):
         for h, l in zip(*ax.get_legend_handles_labels()):
             handles.setdefault(l, h)
     axes[0].legend(handles.values(), handles.keys(), fontsize=7, loc="best")
-    fig.suptitle(f"{scene}: error ({name}) against run time")
+    fig.suptitle(f"{scene}: relative error against run time (table: {scene}.md)")
     fig.tight_layout()
     fig.savefig(png, dpi=110)
 
