@@ -333,3 +333,91 @@ fn a_linear_solve_that_does_not_converge_is_a_divergence_the_step_cuts_on() {
         "{stderr}"
     );
 }
+
+/// Runs `scene` (with `sets`) on `ranks` ranks for `steps` steps with the direct solver,
+/// factoring every Newton iteration and keeping factorisations (`-pfem_lu_reuse`), and returns
+/// the histories' largest relative difference and the second run's (Newton, linear) iterations.
+fn fresh_against_reused_factors(
+    dir: &Path,
+    scene: &str,
+    sets: &[&str],
+    ranks: usize,
+    steps: u32,
+) -> (f64, (usize, usize)) {
+    let until = steps.to_string();
+    let mut args = vec![
+        "new",
+        scene,
+        "-o",
+        "case.h5",
+        "--set",
+        "solver.linear=\"direct\"",
+    ];
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    ok(dir, 1, &args);
+    let mut outs = Vec::new();
+    for reuse in ["false", "true"] {
+        let out = format!("reuse_{reuse}{ranks}");
+        let stdout = ok(
+            dir,
+            ranks,
+            &[
+                "case.h5",
+                "--out",
+                &out,
+                "--until-step",
+                &until,
+                "--",
+                "-pfem_lu_reuse",
+                reuse,
+            ],
+        );
+        outs.push((out, stdout));
+    }
+    let diff = max_relative_difference(
+        &dir.join(&outs[0].0).join("history.csv"),
+        &dir.join(&outs[1].0).join("history.csv"),
+    );
+    (diff, iterations(&outs[1].1))
+}
+
+#[test]
+fn reused_factorisations_match_the_direct_history_on_1_and_2_ranks() {
+    let dir = workdir("reused-factorisations");
+    for ranks in [1, 2] {
+        let (diff, (newton, linear)) = fresh_against_reused_factors(
+            &dir,
+            "cantilever",
+            &["mesh.h=0.25", "steps.count=10"],
+            ranks,
+            3,
+        );
+        println!("cantilever, {ranks} ranks: max relative difference {diff:.2e}, {newton} Newton and {linear} linear iterations");
+        assert!(diff < 1e-6, "{ranks} ranks: {diff:e}");
+        // A fresh factorisation solves in one Krylov iteration; more mean some were kept.
+        assert!(
+            linear > newton,
+            "factorisations were kept: {linear} linear iterations"
+        );
+    }
+}
+
+#[test]
+fn reused_factorisations_solve_the_mixed_plastic_footing() {
+    let dir = workdir("reused-factorisations-footing");
+    let (diff, (newton, linear)) = fresh_against_reused_factors(
+        &dir,
+        "footing-shallow",
+        &[
+            "mesh.h=0.5",
+            "mesh.fine=[{origin=[0.0,8.0],size=[4.0,2.0],h=0.25},\
+             {origin=[0.5,9.5],size=[1.0,0.5],h=0.125}]",
+        ],
+        2,
+        3,
+    );
+    println!("footing-shallow, 2 ranks: max relative difference {diff:.2e}, {newton} Newton and {linear} linear iterations");
+    assert!(diff < 1e-6, "{diff:e}");
+}

@@ -244,7 +244,10 @@ impl<'a> StepProblem<'a> {
     fn cached(&self, local: &[f64]) -> Option<Vec<ElementResult>> {
         let (at, elems) = self.cache.borrow_mut().take()?;
         let same = at.len() == local.len()
-            && at.iter().zip(local).all(|(a, b)| a.to_bits() == b.to_bits());
+            && at
+                .iter()
+                .zip(local)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
         same.then_some(elems)
     }
 
