@@ -42,6 +42,8 @@
 //! newton_max_it = 25         # (default 25)
 //! newton_rtol = 1e-9         # (default 1e-9)
 //! linear = "auto"            # "auto" | "direct" | "iterative" (default "auto", by size)
+//! symmetric = true          # LDLᵀ for symmetric (elastic P2) tangents (default true)
+//! reuse_factorisation = false # keep LU factors while Newton converges fast (default false)
 //! ```
 //!
 //! The field-by-field reference, with the validation rules, is on the types in [`schema`].

@@ -333,3 +333,110 @@ fn a_linear_solve_that_does_not_converge_is_a_divergence_the_step_cuts_on() {
         "{stderr}"
     );
 }
+
+/// Runs `scene` (with `sets`) on `ranks` ranks for `steps` steps with the direct solver three
+/// ways: LU factored every Newton iteration (the reference), the default (LDLᵀ where the
+/// tangent is symmetric), and the default keeping factorisations (`-pfem_lu_reuse true`).
+/// Returns, for the last two, the histories' largest relative difference from the reference
+/// and their (Newton, linear) iterations.
+fn direct_variants(
+    dir: &Path,
+    scene: &str,
+    sets: &[&str],
+    ranks: usize,
+    steps: u32,
+) -> Vec<(f64, (usize, usize))> {
+    let until = steps.to_string();
+    for (case, symmetric) in [("lu.h5", "false"), ("default.h5", "true")] {
+        let symmetric = format!("solver.symmetric={symmetric}");
+        let mut args = vec![
+            "new",
+            scene,
+            "-o",
+            case,
+            "--set",
+            "solver.linear=\"direct\"",
+            "--set",
+            &symmetric,
+        ];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        ok(dir, 1, &args);
+    }
+    let mut outs = Vec::new();
+    for (case, reuse) in [
+        ("lu.h5", "false"),
+        ("default.h5", "false"),
+        ("default.h5", "true"),
+    ] {
+        let out = format!("{}_{reuse}{ranks}", case.trim_end_matches(".h5"));
+        let stdout = ok(
+            dir,
+            ranks,
+            &[
+                case,
+                "--out",
+                &out,
+                "--until-step",
+                &until,
+                "--",
+                "-pfem_lu_reuse",
+                reuse,
+            ],
+        );
+        outs.push((out, stdout));
+    }
+    let reference = dir.join(&outs[0].0).join("history.csv");
+    outs[1..]
+        .iter()
+        .map(|(out, stdout)| {
+            let diff = max_relative_difference(&reference, &dir.join(out).join("history.csv"));
+            (diff, iterations(stdout))
+        })
+        .collect()
+}
+
+#[test]
+fn symmetric_and_reused_factorisations_match_the_lu_history_on_1_and_2_ranks() {
+    let dir = workdir("direct-variants");
+    for ranks in [1, 2] {
+        let runs = direct_variants(
+            &dir,
+            "cantilever",
+            &["mesh.h=0.25", "steps.count=10"],
+            ranks,
+            3,
+        );
+        for ((diff, (newton, linear)), what) in runs.iter().zip(["LDLT", "LDLT kept"]) {
+            println!("cantilever, {ranks} ranks, {what}: max relative difference from LU {diff:.2e}, {newton} Newton and {linear} linear iterations");
+            assert!(*diff < 1e-6, "{what}, {ranks} ranks: {diff:e}");
+        }
+        // A fresh factorisation solves in one Krylov iteration; more mean some were kept.
+        let (newton, linear) = runs[1].1;
+        assert!(
+            linear > newton,
+            "factorisations were kept: {linear} linear iterations"
+        );
+    }
+}
+
+#[test]
+fn reused_factorisations_solve_the_mixed_plastic_footing() {
+    let dir = workdir("direct-variants-footing");
+    let runs = direct_variants(
+        &dir,
+        "footing-shallow",
+        &[
+            "mesh.h=0.5",
+            "mesh.fine=[{origin=[0.0,8.0],size=[4.0,2.0],h=0.25},\
+             {origin=[0.5,9.5],size=[1.0,0.5],h=0.125}]",
+        ],
+        2,
+        3,
+    );
+    for ((diff, (newton, linear)), what) in runs.iter().zip(["default", "kept"]) {
+        println!("footing-shallow, 2 ranks, {what}: max relative difference from LU {diff:.2e}, {newton} Newton and {linear} linear iterations");
+        assert!(*diff < 1e-6, "{what}: {diff:e}");
+    }
+}

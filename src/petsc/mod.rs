@@ -25,7 +25,7 @@ const _: () = assert!(std::mem::size_of::<Scalar>() == std::mem::size_of::<f64>(
 pub use error::PetscError;
 pub use index_set::IndexSet;
 pub use init::Petsc;
-pub use linear::LinearSolver;
+pub use linear::{FactorReuse, LinearSolver};
 pub use matrix::{Mat, MatRef};
 pub use nullspace::NullSpace;
 pub use reason::{Divergence, KspDiverged, SnesDiverged, SolveFailure};

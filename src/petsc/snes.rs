@@ -1,7 +1,7 @@
 use super::error::{check, PetscError};
 use super::ffi;
 use super::init::cstring;
-use super::linear::LinearSolver;
+use super::linear::{FactorReuse, LinearSolver};
 use super::matrix::{to_int, Mat, MatRef};
 use super::reason::{Divergence, KspDiverged, SnesDiverged, SolveFailure};
 use super::vector::{PVec, VecRef};
@@ -39,11 +39,15 @@ pub struct SolveStats {
 /// A SNES we own; destroyed on drop.
 pub struct Snes {
     raw: ffi::SNES,
+    reuse: Option<FactorReuse>,
 }
 
 struct Ctx<'a> {
     problem: &'a mut dyn NonlinearProblem,
     error: Option<String>,
+    reuse: Option<FactorReuse>,
+    /// The residual norm at the last Jacobian of this solve.
+    last_norm: Option<f64>,
 }
 
 const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
@@ -71,7 +75,11 @@ impl Snes {
         // SAFETY: fresh handle; KSP/PC are borrowed from the SNES and not destroyed by us.
         unsafe {
             check(ffi::SNESCreate(comm.as_raw(), &mut raw), "SNESCreate")?;
-            let snes = Snes { raw };
+            let reuse = match linear {
+                LinearSolver::Direct { reuse, .. } => *reuse,
+                _ => None,
+            };
+            let snes = Snes { raw, reuse };
             check(
                 ffi::SNESSetTolerances(
                     raw,
@@ -120,6 +128,8 @@ impl Snes {
         let mut ctx = Ctx {
             problem,
             error: None,
+            reuse: self.reuse,
+            last_norm: None,
         };
         let ctx_ptr = &mut ctx as *mut Ctx as *mut c_void;
         // SAFETY: ctx outlives SNESSolve, the only place the callbacks run; the callbacks catch
@@ -291,5 +301,61 @@ unsafe extern "C" fn jacobian_cb(
         let (x, j) = unsafe { (VecRef::lent(x), MatRef::lent(j)) };
         ctx.problem.jacobian(x, j)
     }));
-    report(snes, ctx, outcome)
+    let code = report(snes, ctx, outcome);
+    if code != 0 {
+        return code;
+    }
+    match ctx.reuse {
+        Some(reuse) => match choose_factorisation(snes, &reuse, &mut ctx.last_norm) {
+            Ok(()) => 0,
+            Err(e) => {
+                ctx_note(ctx, Some(()), &e.to_string());
+                PETSC_ERR_USER
+            }
+        },
+        None => 0,
+    }
+}
+
+/// Tells SNES whether the next linear solve factors the new tangent or keeps the last factors
+/// (see [`FactorReuse`]). SNES reads the preconditioner lag after the Jacobian callback: −2
+/// rebuilds once, −1 keeps. Every rank decides alike: the residual norm and the Krylov count
+/// are global.
+fn choose_factorisation(
+    snes: ffi::SNES,
+    reuse: &FactorReuse,
+    last_norm: &mut Option<f64>,
+) -> Result<(), PetscError> {
+    let mut norm = 0.0;
+    let mut ksp: ffi::KSP = std::ptr::null_mut();
+    let mut its: ffi::PetscInt = 0;
+    let mut reason: ffi::KSPConvergedReason = 0;
+    // SAFETY: live SNES inside its own callback; its KSP is borrowed.
+    unsafe {
+        check(
+            ffi::SNESGetFunctionNorm(snes, &mut norm),
+            "SNESGetFunctionNorm",
+        )?;
+        check(ffi::SNESGetKSP(snes, &mut ksp), "SNESGetKSP")?;
+        check(
+            ffi::KSPGetIterationNumber(ksp, &mut its),
+            "KSPGetIterationNumber",
+        )?;
+        check(
+            ffi::KSPGetConvergedReason(ksp, &mut reason),
+            "KSPGetConvergedReason",
+        )?;
+    }
+    // The first Jacobian of a solve has no last norm: a new increment's tangent is factored.
+    let keep = last_norm.is_some_and(|last| norm <= reuse.contraction * last)
+        && reason > 0
+        && (its.max(0) as usize) <= reuse.max_krylov;
+    *last_norm = Some(norm);
+    // SAFETY: as above.
+    unsafe {
+        check(
+            ffi::SNESSetLagPreconditioner(snes, if keep { -1 } else { -2 }),
+            "SNESSetLagPreconditioner",
+        )
+    }
 }

@@ -303,7 +303,10 @@ impl Simulation {
                 pressure_mass: &s.pressure_mass,
             },
             None if iterative => LinearSolver::Amg { rtol: AMG_RTOL },
-            None => LinearSolver::Direct,
+            None => LinearSolver::Direct {
+                reuse: crate::petsc::FactorReuse::from_options(solver.reuse_factorisation)?,
+                symmetric: self.symmetric_tangent(),
+            },
         };
         // A residual at round-off of the body's force scale (E h, N/m) is converged: a step
         // with no load at all (a body released from its platen) has no first residual for the
@@ -327,6 +330,20 @@ impl Simulation {
             split,
             snes,
         })
+    }
+
+    /// Whether every tangent of the scene is symmetric: an elastic P2 solid (the material and
+    /// geometric stiffness of a hyperelastic step are), with dead loads only (point loads and
+    /// gravity keep their direction; follower pressures and contact do not) and prescribed
+    /// displacements eliminated symmetrically. `solver.symmetric = false` or the PETSc options
+    /// `-pc_type lu -pc_factor_mat_solver_type mumps` factor LU anyway.
+    fn symmetric_tangent(&self) -> bool {
+        let m = &self.model;
+        m.scene.solver.symmetric
+            && !m.plastic()
+            && !m.mixed()
+            && m.bodies.is_empty()
+            && m.scene.surface_pressure.is_empty()
     }
 
     /// Collective. The index sets of the displacement and pressure fields of a mixed system,

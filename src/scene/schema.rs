@@ -364,6 +364,16 @@ pub struct Solver {
     /// the displacements and the pressure mass matrix scaled by 1/G on the pressures, for
     /// `"p2p1"`). PETSc options on the command line (`-ksp_type`, `-pc_type`, ...) override it.
     pub linear: LinearChoice,
+    /// Whether the direct solver factors LDLᵀ (MUMPS) instead of LU where every tangent is
+    /// symmetric: an elastic `"p2"` scene without rigid bodies or surface pressures. Half the
+    /// factor's entries and flops; the history is LU's to round-off. Default true.
+    pub symmetric: bool,
+    /// Whether the direct solver keeps a factorisation for the next Newton iteration while
+    /// Newton converges fast, solving the exact tangent with GCR preconditioned by it
+    /// (relative tolerance 1e-10). Default false: on the cantilever each kept factorisation
+    /// needed 5–9 Krylov iterations, as dear as factoring afresh. The PETSc option
+    /// `-pfem_lu_reuse true|false` overrides it.
+    pub reuse_factorisation: bool,
 }
 
 /// `solver.linear`.
@@ -406,6 +416,8 @@ impl Default for Solver {
             element: ElementChoice::Auto,
             line_search: LineSearch::Auto,
             linear: LinearChoice::Auto,
+            symmetric: true,
+            reuse_factorisation: false,
         }
     }
 }
