@@ -4,7 +4,9 @@
 set -euo pipefail
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 # Concurrent jobs (tests, studies) would all pin their rank 0 to core 0: let the kernel place ranks.
-export OMPI_MCA_hwloc_base_binding_policy=none
+# Unbound, a rank sees every core: one OpenMP thread per rank (SuperLU_dist, MUMPS), or the
+# ranks oversubscribe the cores and SuperLU_dist's sums lose their fixed order.
+export OMPI_MCA_hwloc_base_binding_policy=none OMP_NUM_THREADS=1
 cargo build --release -q
 bin=$PWD/target/release/pfem-mpi
 work=target/bench/$1

@@ -292,22 +292,10 @@ fn a_damaged_scene_attribute_is_an_error_not_a_panic() {
 /// Runs the small cantilever on 2 ranks with `PFEM_INJECT_FAULT=spec`; returns (success,
 /// stderr, seconds), failing the test if the job is not over within 30 s.
 fn injected(dir: &Path, spec: &str) -> (bool, String, f64) {
-    let mut child = Command::new("mpirun")
-        .args([
-            "-n",
-            "2",
-            "--oversubscribe",
-            "--bind-to",
-            "none",
-            bin(),
-            "c.h5",
-            "--out",
-        ])
+    let mut child = mpirun(2)
+        .args(["c.h5", "--out"])
         .arg(format!("out-{}", spec.replace(':', "-")))
         .current_dir(dir)
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-        .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
         .env("PFEM_INJECT_FAULT", spec)
         .stdin(Stdio::null())
         .stdout(Stdio::null())

@@ -15,26 +15,9 @@ const LIMIT: Duration = Duration::from_secs(60);
 /// Runs `pfem-mpi args` on `ranks` ranks in `dir`; fails the test unless it ends within
 /// `LIMIT` (after which the launcher is killed). Returns (success, exit code, stderr).
 fn run_limited(dir: &Path, ranks: usize, args: &[&str]) -> (bool, Option<i32>, String) {
-    let mut cmd = if ranks == 1 {
-        Command::new(bin())
-    } else {
-        let mut c = Command::new("mpirun");
-        c.args([
-            "-n",
-            &ranks.to_string(),
-            "--oversubscribe",
-            "--bind-to",
-            "none",
-            bin(),
-        ]);
-        c
-    };
-    let mut child = cmd
+    let mut child = pfem(ranks)
         .args(args)
         .current_dir(dir)
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-        .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::piped())

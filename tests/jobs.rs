@@ -48,7 +48,8 @@ fn script(dir: &Path, name: &str, args: &[&str], envs: &[(&str, &str)]) -> Comma
         .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
-        .env("OMPI_MCA_hwloc_base_binding_policy", "none");
+        .env("OMPI_MCA_hwloc_base_binding_policy", "none")
+        .env("OMP_NUM_THREADS", "1");
     for (k, v) in envs {
         cmd.env(k, v);
     }

@@ -45,22 +45,8 @@ fn run_case(
     ranks: usize,
     rotate: bool,
 ) -> (String, Vec<Vec<f64>>) {
-    let mut cmd = Command::new("mpirun");
-    cmd.args([
-        "-n",
-        &ranks.to_string(),
-        "--oversubscribe",
-        "--bind-to",
-        "none",
-        bin(),
-        case,
-        "--out",
-        out,
-    ])
-    .current_dir(dir)
-    .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-    .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    .env("OMPI_MCA_rmaps_base_oversubscribe", "1");
+    let mut cmd = mpirun(ranks);
+    cmd.args([case, "--out", out]).current_dir(dir);
     if rotate {
         cmd.env("PFEM_TEST_REPARTITION", "rotate");
     }

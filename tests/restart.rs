@@ -71,18 +71,7 @@ fn restart_on_same_and_other_rank_counts() {
 fn spawn(dir: &Path, mpi_ranks: Option<usize>, args: &[&str]) -> std::process::Child {
     let mut cmd = match mpi_ranks {
         None => Command::new(bin()),
-        Some(n) => {
-            let mut c = Command::new("mpirun");
-            c.args([
-                "-n",
-                &n.to_string(),
-                "--oversubscribe",
-                "--bind-to",
-                "none",
-                bin(),
-            ]);
-            c
-        }
+        Some(n) => mpirun(n),
     };
     cmd.args(args)
         .current_dir(dir)

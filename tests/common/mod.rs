@@ -14,6 +14,41 @@ pub fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_pfem-mpi")
 }
 
+/// `pfem-mpi` under `mpirun -n ranks`, allowed as root, oversubscribed and unbound (Open MPI
+/// would pin rank 0 of every concurrent test's job to core 0, where they starve each other),
+/// one OpenMP thread per rank.
+pub fn mpirun(ranks: usize) -> Command {
+    let mut c = Command::new("mpirun");
+    c.args([
+        "-n",
+        &ranks.to_string(),
+        "--oversubscribe",
+        "--bind-to",
+        "none",
+        bin(),
+    ]);
+    with_mpi_env(c)
+}
+
+/// `pfem-mpi` as a plain process for one rank, under [`mpirun`] for more.
+pub fn pfem(ranks: usize) -> Command {
+    if ranks == 1 {
+        with_mpi_env(Command::new(bin()))
+    } else {
+        mpirun(ranks)
+    }
+}
+
+/// Unbound, a rank would see both cores and the OpenMP threads of SuperLU_dist would add in a
+/// varying order: the bitwise-reproducibility tests need one thread per rank.
+fn with_mpi_env(mut c: Command) -> Command {
+    c.env("OMP_NUM_THREADS", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("OMPI_MCA_rmaps_base_oversubscribe", "1");
+    c
+}
+
 /// A fresh directory under the target dir, unique per test.
 pub fn workdir(name: &str) -> PathBuf {
     static N: AtomicUsize = AtomicUsize::new(0);
@@ -29,25 +64,8 @@ pub fn workdir(name: &str) -> PathBuf {
 
 /// Runs `pfem-mpi args` on `ranks` ranks (plain process for 1), in `dir`.
 pub fn run(dir: &Path, ranks: usize, args: &[&str]) -> Output {
-    let mut cmd = if ranks == 1 {
-        Command::new(bin())
-    } else {
-        let mut c = Command::new("mpirun");
-        c.args([
-            "-n",
-            &ranks.to_string(),
-            "--oversubscribe",
-            "--bind-to",
-            "none",
-            bin(),
-        ]);
-        c
-    };
-    cmd.args(args)
-        .current_dir(dir)
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-        .env("OMPI_MCA_rmaps_base_oversubscribe", "1");
+    let mut cmd = pfem(ranks);
+    cmd.args(args).current_dir(dir);
     cmd.output().expect("launch pfem-mpi")
 }
 
