@@ -6,7 +6,6 @@ mod common;
 use common::*;
 
 use std::path::Path;
-use std::process::Command;
 
 /// The 9-particle block of the issue: 1 m x 1 m, h = 0.5, fixed bottom, 1 kN at the top corner.
 fn block9(dir: &Path) {
