@@ -88,20 +88,7 @@ fn last_count(stdout: &str, name: &str) -> u64 {
 #[test]
 fn per_rank_table_adds_up_on_one_and_two_ranks() {
     let dir = workdir("rank-table");
-    ok(
-        &dir,
-        1,
-        &[
-            "new",
-            "cantilever",
-            "-o",
-            "c.h5",
-            "--set",
-            "mesh.h=0.25",
-            "--set",
-            "steps.count=4",
-        ],
-    );
+    small_cantilever(&dir, 4, &[]);
     let mut global_dofs = Vec::new();
     for ranks in [1, 2] {
         let out = format!("o{ranks}");
