@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{ok, workdir};
+use common::{ok, small_cantilever, workdir};
 
 /// One row of the table: rank, owned, ghost, dofs, ghost_dofs, owned_tris, local_tris,
 /// solve_cpu, cpu_total, peak_rss_MB.
