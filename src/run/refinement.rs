@@ -4,7 +4,7 @@
 use super::Simulation;
 use crate::fem::recovery::{barycentric, interpolate_linear};
 use crate::material::GaussState;
-use crate::mesh::refine::{plan, RefineParams};
+use crate::mesh::refine::{deep_chords, plan, RefineParams};
 use crate::mesh::LocalMesh;
 use crate::particles::flag;
 use pfem_partition::{allgather_u64, sum_f64, Comm};
@@ -14,6 +14,10 @@ const K: usize = GaussState::LEN;
 
 /// A boundary particle this close to a rigid body (in its spacing) slides on it.
 const SLIDING_GAP: f64 = 0.1;
+
+/// A boundary chord cutting this deep into a rigid body (in its spacing) is split
+/// (`deep_chords`).
+const MAX_CHORD_DEPTH: f64 = 0.1;
 
 impl Simulation {
     /// Collective. Inserts, removes and smooths particles as the scene asks; returns whether
@@ -72,6 +76,19 @@ impl Simulation {
             })
         };
         let mut plan = plan(mesh, protected, slides, support_gap, &params);
+        if settings.refine && !bodies.is_empty() {
+            let depth = |x: [f64; 2]| {
+                bodies
+                    .iter()
+                    .map(|s| -s.closest(x).distance)
+                    .fold(f64::NEG_INFINITY, f64::max)
+            };
+            for e in deep_chords(mesh, depth, MAX_CHORD_DEPTH) {
+                if !plan.split.contains(&e) {
+                    plan.split.push(e);
+                }
+            }
+        }
         if !settings.refine {
             plan.split.clear();
             plan.remove.clear();
