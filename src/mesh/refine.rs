@@ -196,11 +196,14 @@ pub fn plan(
 /// first cuts in, it follows the face in smaller, even steps. A chord of length L on a face of
 /// radius R cuts in by L²/8R: on the default T-bar's and pipe's faces (R = 4 spacings) that
 /// stays below 0.1 spacing up to the split length; on their coarse test meshes (R = 2
-/// spacings) it splits chords longer than 1.26 spacings.
+/// spacings) it splits chords longer than 1.26 spacings. Only chords longer than `min_length`
+/// spacings are split: round a sharp corner every chord cuts in, and halves shorter than the
+/// merge distance would be merged again at the next step.
 pub fn deep_chords(
     mesh: &LocalMesh,
     depth: impl Fn([f64; 2]) -> f64,
     max_depth: f64,
+    min_length: f64,
 ) -> Vec<[u32; 2]> {
     let mut out = Vec::new();
     for &[a, b] in &mesh.boundary_edges {
@@ -212,7 +215,8 @@ pub fn deep_chords(
         let (p, q) = (mesh.points[a as usize], mesh.points[b as usize]);
         let mid = [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])];
         let h = mesh.h[a as usize].max(mesh.h[b as usize]);
-        if depth(mid) > max_depth * h {
+        let long = (q[0] - p[0]).hypot(q[1] - p[1]) > min_length * h;
+        if long && depth(mid) > max_depth * h {
             out.push([lo, hi]);
         }
     }
@@ -377,12 +381,14 @@ mod tests {
             let centre = [1.5, 2.0 + (r * r - 0.25_f64).sqrt()];
             move |x: [f64; 2]| r - ((x[0] - centre[0]).powi(2) + (x[1] - centre[1]).powi(2)).sqrt()
         };
-        let deep = deep_chords(&m, inside(1.2), 0.1);
+        let deep = deep_chords(&m, inside(1.2), 0.1, 0.9);
         assert_eq!(deep.len(), 1, "{deep:?}");
         let [p, q] = deep[0].map(|v| m.points[v as usize]);
         let mut xs = [p[0], q[0]];
         xs.sort_by(f64::total_cmp);
         assert_eq!((xs, p[1], q[1]), ([1.0, 2.0], 2.0, 2.0));
-        assert!(deep_chords(&m, inside(1.6), 0.1).is_empty());
+        assert!(deep_chords(&m, inside(1.6), 0.1, 0.9).is_empty());
+        // Too short to split (a sharp corner).
+        assert!(deep_chords(&m, inside(1.2), 0.1, 1.1).is_empty());
     }
 }

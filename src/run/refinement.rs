@@ -19,6 +19,10 @@ const SLIDING_GAP: f64 = 0.1;
 /// (`deep_chords`).
 const MAX_CHORD_DEPTH: f64 = 0.1;
 
+/// ...if it is longer than this (in its spacing): its halves stay clear of the merge distance
+/// (0.4).
+const MIN_CHORD_SPLIT: f64 = 1.0;
+
 impl Simulation {
     /// Collective. Inserts, removes and smooths particles as the scene asks; returns whether
     /// anything changed anywhere (then the mesh must be rebuilt).
@@ -83,7 +87,7 @@ impl Simulation {
                     .map(|s| -s.closest(x).distance)
                     .fold(f64::NEG_INFINITY, f64::max)
             };
-            for e in deep_chords(mesh, depth, MAX_CHORD_DEPTH) {
+            for e in deep_chords(mesh, depth, MAX_CHORD_DEPTH, MIN_CHORD_SPLIT) {
                 if !plan.split.contains(&e) {
                     plan.split.push(e);
                 }
