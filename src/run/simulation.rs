@@ -35,7 +35,7 @@ pub struct Simulation {
     /// Contact augmentations (Newton solves after the first) since the last step report.
     pub(super) augmentations: std::cell::Cell<u64>,
     /// The current piece is being retried with the other line search.
-    pub(super) alternate_search: std::cell::Cell<u8>,
+    pub(super) alternate_search: std::cell::Cell<bool>,
     /// Seconds spent on contact since the last step report.
     pub(super) contact_seconds: std::cell::Cell<f64>,
     /// PETSc objects of the last increment (kept while the matrix pattern stays the same).

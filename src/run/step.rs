@@ -252,7 +252,7 @@ impl Simulation {
     ) -> Result<SolverObjects, crate::petsc::PetscError> {
         // A different line search is a different SNES.
         let alternate = self.alternate_search.get();
-        let signature = pattern_signature(dofs) ^ u64::from(alternate).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        let signature = pattern_signature(dofs) ^ if alternate { 0x9e37_79b9_7f4a_7c15 } else { 0 };
         let cached = self.solver.borrow_mut().take();
         let same = cached.as_ref().is_some_and(|c| c.signature == signature);
         if sum_f64(world, &[if same { 0.0 } else { 1.0 }])[0] == 0.0 {
@@ -272,19 +272,13 @@ impl Simulation {
             LineSearch::L2 => "l2",
             LineSearch::Cp => "cp",
         };
-        // The first retry after a divergence: full steps if the line search backtracked, else
+        // The retry after a divergence: full steps if the line search backtracked, else
         // backtracking. Backtracking can stall at a kink of the plastic or contact response that
         // a full step jumps over, and a full step can overshoot where backtracking does not.
-        // The second: the secant line search on the residual norm (`l2`). On the footing at
-        // h/2 (2 ranks, z/B = 0.63) both stalled at the rounded edge on every piece down to
-        // 1/64 of the step, with the residual 7.9e2 at contact nodes on the arc; `l2` took the
-        // whole step.
         let line_search = match (alternate, line_search) {
-            (0, ls) => ls,
-            (1, "bt") => "basic",
-            (1, _) => "bt",
-            (_, "l2") => "cp",
-            (_, _) => "l2",
+            (false, ls) => ls,
+            (true, "bt") => "basic",
+            (true, _) => "bt",
         };
         let iterative = match solver.linear {
             LinearChoice::Direct => false,
@@ -662,13 +656,10 @@ impl Simulation {
 /// Halvings of a step's increment before a Newton failure is final.
 const MAX_CUTS: usize = 6;
 
-/// Retries of a diverged piece with other line searches before it is cut.
-const RETRIES: u8 = 2;
-
 impl Simulation {
     /// Collective. Solves the next step on `mesh` and moves the particles. When Newton diverges,
-    /// the piece is tried again with the other line search (full steps or backtracking) and
-    /// then with the secant one, then the rest of the step is cut in half (up to 6 times, growing back after each success), each
+    /// the piece is tried once more with the other line search (full steps or backtracking),
+    /// then the rest of the step is cut in half (up to 6 times, growing back after each success), each
     /// piece a full remesh–map–solve–update cycle; `mesh` ends as the mesh of the last piece.
     pub fn advance(
         &mut self,
@@ -691,7 +682,7 @@ impl Simulation {
             };
             match self.solve(world, petsc, mesh, &states, from, to) {
                 Ok(solved) => {
-                    self.alternate_search.set(0);
+                    self.alternate_search.set(false);
                     let completes = to == target;
                     let mut report = self.update(world, mesh, solved, completes)?;
                     report.penetration = self.check_penetration(world)?;
@@ -712,11 +703,11 @@ impl Simulation {
                     *mesh = self.remesh(world)?;
                     states = self.map(mesh);
                 }
-                Err(SolveError::Diverged(_)) if self.alternate_search.get() < RETRIES => {
-                    self.alternate_search.set(self.alternate_search.get() + 1);
+                Err(SolveError::Diverged(_)) if !self.alternate_search.get() => {
+                    self.alternate_search.set(true);
                 }
                 Err(SolveError::Diverged(_)) if cuts < MAX_CUTS => {
-                    self.alternate_search.set(0);
+                    self.alternate_search.set(false);
                     cuts += 1;
                     piece *= 0.5;
                 }
