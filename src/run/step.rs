@@ -179,6 +179,7 @@ impl Simulation {
         let step = self.header.step + 1;
         let dofs =
             DofMap::build(world, mesh, self.model.mixed()).map_err(|e| err(e.to_string()))?;
+        crate::mem_probe::probe("solve: dofmap");
         let constraints = Constraints::build(&dofs, |p| {
             self.model
                 .step_bc(self.reference_position(mesh, p), mesh.points[p], from, to)
@@ -219,11 +220,13 @@ impl Simulation {
         let mut cache = self
             .solver_objects(world, mesh, &dofs)
             .map_err(|e| err(e.to_string()))?;
+        crate::mem_probe::probe("solve: solver objects");
         let outcome = self.solve_with(
             world, mesh, &dofs, setup, &spacing, &mut cache, scale, from, step,
         );
         // Kept for the next increment on the same pattern (a cut piece, or an unchanged mesh).
         *self.solver.borrow_mut() = Some(cache);
+        crate::mem_probe::probe("solve: end");
         outcome.map(|o| Solved {
             dlambda: to - from,
             dofs,
@@ -401,6 +404,9 @@ impl Simulation {
         } = objects;
         let mut problem =
             StepProblem::new(world, mesh, dofs, setup, x).map_err(|e| err(e.to_string()))?;
+        if *amg || split.is_some() {
+            problem = problem.without_element_cache();
+        }
         if let Some(split) = split {
             problem = problem.with_schur_preconditioner(SchurPreconditioner {
                 matrix: &split.pressure_mass,
@@ -443,6 +449,7 @@ impl Simulation {
                 }
             })
             .map_err(|e| err(e.to_string()))?;
+        crate::mem_probe::probe("solve: problem+guess");
         let mut newton = |problem: &mut StepProblem, x: &mut PVec, jac: &mut Mat| {
             snes.solve(problem, x, jac).map_err(|e| match e {
                 SolveFailure::Diverged(d) => SolveError::Diverged(format!("step {step}: {d}")),
@@ -492,6 +499,7 @@ impl Simulation {
             }
         }
         self.add_contact_time(clock);
+        crate::mem_probe::probe("solve: newton done");
         let local = problem
             .local_values(x.as_ref())
             .map_err(|e| err(e.to_string()))?;
@@ -525,6 +533,7 @@ impl Simulation {
                 contact_state.insert((key, c.body), [f.pressure, f.shear]);
             }
         }
+        crate::mem_probe::probe("solve: final elements+reactions");
         let du = problem.node_displacements(&local);
         let pressure = problem.node_pressures(&local);
         Ok(Outcome {
