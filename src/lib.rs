@@ -10,7 +10,6 @@ pub mod commands;
 pub mod fem;
 pub mod history;
 pub mod mapping;
-pub mod mem_probe;
 pub mod material;
 pub mod mesh;
 pub mod model;

@@ -94,12 +94,6 @@ impl Snes {
             let mut ksp: ffi::KSP = std::ptr::null_mut();
             check(ffi::SNESGetKSP(raw, &mut ksp), "SNESGetKSP")?;
             linear.configure(ksp)?;
-            if std::env::var_os("PFEM_MEM_PROBE").is_some() {
-                check(
-                    ffi::KSPMonitorSet(ksp, Some(mem_monitor), std::ptr::null_mut(), None),
-                    "KSPMonitorSet",
-                )?;
-            }
             check(
                 ffi::SNESSetLagPreconditioner(
                     raw,
@@ -277,18 +271,6 @@ fn ctx_note(ctx: &mut Ctx, fatal: Option<()>, msg: &str) {
     }
 }
 
-unsafe extern "C" fn mem_monitor(
-    _ksp: ffi::KSP,
-    it: ffi::PetscInt,
-    _norm: ffi::PetscReal,
-    _ctx: *mut c_void,
-) -> ffi::PetscErrorCode {
-    if it == 0 || it == 1 || it % 20 == 0 {
-        crate::mem_probe::probe(&format!("ksp it {it}"));
-    }
-    0
-}
-
 unsafe extern "C" fn residual_cb(
     snes: ffi::SNES,
     x: ffi::Vec,
@@ -320,7 +302,6 @@ unsafe extern "C" fn jacobian_cb(
         ctx.problem.jacobian(x, j)
     }));
     let code = report(snes, ctx, outcome);
-    crate::mem_probe::probe("jacobian: returned");
     if code != 0 {
         return code;
     }

@@ -75,10 +75,8 @@ fn drive(
     let fault = |phase: &str, step: u64| test_hooks::inject(rank, phase, step);
     fault("load", 0)?;
     let sim = held.insert(Simulation::load(world, &opts.case)?);
-    crate::mem_probe::probe("load");
     sanity::check_until_step(opts, sim)?;
     let mut out = output::Output::open(world, sim, &opts.out_dir)?;
-    crate::mem_probe::probe("output open");
     let mut progress = Progress::new(world, sim.total_steps());
     let mut last = opts.until_step.unwrap_or(u64::MAX).min(sim.total_steps());
     // The per-rank table after the end-of-run line: sizes of the last mesh, CPU of the solves.
@@ -91,17 +89,14 @@ fn drive(
             fault("remesh", next)?;
             sim.remesh(world)
         })?;
-        crate::mem_probe::probe("remesh");
         fault("map", next)?;
         let states = t.time("map", || sim.map(&mesh));
-        crate::mem_probe::probe("map");
         let cpu = rank_table::cpu_seconds();
         let report = t.time("solve", || {
             fault("solve", next)?;
             sim.advance(world, petsc, &mut mesh, states)
         })?;
         solve_cpu += rank_table::cpu_seconds() - cpu;
-        crate::mem_probe::probe("advance (after update)");
         sanity::check_step(world, sim, &mesh, &report)?;
         if stop.requested(world) {
             last = sim.step();
@@ -111,7 +106,6 @@ fn drive(
             out.record(world, sim)
                 .and_then(|_| out.fields_if_due(world, sim, &mesh, last))
         })?;
-        crate::mem_probe::probe("output");
         t.time("checkpoint", || {
             fault("checkpoint", next)?;
             out.checkpoint_if_due(world, sim, last)
@@ -120,7 +114,6 @@ fn drive(
             fault("balance", next)?;
             sim.rebalance_if_needed(world)
         })?;
-        crate::mem_probe::probe("checkpoint+balance");
         progress.step(sim, &report, &t);
         // Measured once, on the last mesh: the same condition on every rank (`last` is agreed).
         if sim.step() >= last {

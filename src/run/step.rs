@@ -179,7 +179,6 @@ impl Simulation {
         let step = self.header.step + 1;
         let dofs =
             DofMap::build(world, mesh, self.model.mixed()).map_err(|e| err(e.to_string()))?;
-        crate::mem_probe::probe("solve: dofmap");
         let constraints = Constraints::build(&dofs, |p| {
             self.model
                 .step_bc(self.reference_position(mesh, p), mesh.points[p], from, to)
@@ -220,13 +219,11 @@ impl Simulation {
         let mut cache = self
             .solver_objects(world, mesh, &dofs)
             .map_err(|e| err(e.to_string()))?;
-        crate::mem_probe::probe("solve: solver objects");
         let outcome = self.solve_with(
             world, mesh, &dofs, setup, &spacing, &mut cache, scale, from, step,
         );
         // Kept for the next increment on the same pattern (a cut piece, or an unchanged mesh).
         *self.solver.borrow_mut() = Some(cache);
-        crate::mem_probe::probe("solve: end");
         outcome.map(|o| Solved {
             dlambda: to - from,
             dofs,
@@ -453,7 +450,6 @@ impl Simulation {
                 }
             })
             .map_err(|e| err(e.to_string()))?;
-        crate::mem_probe::probe("solve: problem+guess");
         let mut newton = |problem: &mut StepProblem, x: &mut PVec, jac: &mut Mat| {
             snes.solve(problem, x, jac).map_err(|e| match e {
                 SolveFailure::Diverged(d) => SolveError::Diverged(format!("step {step}: {d}")),
@@ -503,7 +499,6 @@ impl Simulation {
             }
         }
         self.add_contact_time(clock);
-        crate::mem_probe::probe("solve: newton done");
         let local = problem
             .local_values(x.as_ref())
             .map_err(|e| err(e.to_string()))?;
@@ -537,7 +532,6 @@ impl Simulation {
                 contact_state.insert((key, c.body), [f.pressure, f.shear]);
             }
         }
-        crate::mem_probe::probe("solve: final elements+reactions");
         let du = problem.node_displacements(&local);
         let pressure = problem.node_pressures(&local);
         Ok(Outcome {

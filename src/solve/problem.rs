@@ -367,7 +367,8 @@ impl<'a> StepProblem<'a> {
             return Err(CallbackError::Domain(msg));
         }
         if first {
-            self.diagonal.set(Some(self.mean_free_diagonal(diagonal_sum)));
+            self.diagonal
+                .set(Some(self.mean_free_diagonal(diagonal_sum)));
         }
         if store {
             *self.cache.borrow_mut() = Some((local.clone(), cached.unwrap_or(keep)));
@@ -623,7 +624,6 @@ impl StepProblem<'_> {
 
 impl NonlinearProblem for StepProblem<'_> {
     fn residual(&mut self, x: VecRef<'_>, f: VecRef<'_>) -> Result<(), CallbackError> {
-        crate::mem_probe::probe("residual: entry");
         let first = self.dofs.first_dof;
         let mut evaluated = Ok(Vec::new());
         f.write(|fa| {
@@ -639,7 +639,6 @@ impl NonlinearProblem for StepProblem<'_> {
         })
         .map_err(|e| CallbackError::Fatal(e.to_string()))?;
         let local = evaluated?;
-        crate::mem_probe::probe("residual: elements");
         // Read after the evaluation: the first one of the increment fixes it.
         let diagonal = self.constrained_diagonal();
         f.write(|fa| {
@@ -669,12 +668,10 @@ impl NonlinearProblem for StepProblem<'_> {
             }
         })
         .map_err(|e| CallbackError::Fatal(e.to_string()))?;
-        crate::mem_probe::probe("residual: exit");
         Ok(())
     }
 
     fn jacobian(&mut self, x: VecRef<'_>, j: MatRef<'_>) -> Result<(), CallbackError> {
-        crate::mem_probe::probe("jacobian: entry");
         let fatal = |e: PetscError| CallbackError::Fatal(e.to_string());
         let l2g = self
             .dofs
@@ -727,7 +724,6 @@ impl NonlinearProblem for StepProblem<'_> {
             }
             Err(e) => return Err(e),
         };
-        crate::mem_probe::probe("jacobian: add_values");
         self.external_tangent(&local, |r, c, v| j.add_values(&[r], &[c], &[v]))
             .map_err(fatal)?;
         let diagonal = self.constrained_diagonal();
@@ -746,9 +742,7 @@ impl NonlinearProblem for StepProblem<'_> {
             self.assemble_schur_preconditioner(schur, &local)
                 .map_err(fatal)?;
         }
-        let r = j.assemble().map_err(fatal);
-        crate::mem_probe::probe("jacobian: assembled");
-        r
+        j.assemble().map_err(fatal)
     }
 }
 
