@@ -23,8 +23,14 @@ pub enum LinearSolver<'a> {
         symmetric: bool,
     },
     /// Right-preconditioned GMRES with GAMG, for the displacement (P2) system: the matrix must
-    /// carry block size 2 and the rigid-body near-null space.
-    Amg { rtol: Scalar },
+    /// carry block size 2 and the rigid-body near-null space. With `symmetric` (the caller
+    /// knows the tangent is symmetric) conjugate gradients instead, with the same tolerance on
+    /// the true residual: GMRES keeps one vector per iteration (8 doubles per particle each)
+    /// and the solves take 35 and more iterations, where CG keeps four. Measured on the
+    /// cantilever at h = 1/128 (165 k particles, 2 ranks, one step): peak RSS 1490 MB per rank
+    /// with GMRES, 1255 MB with CG, 182 Krylov iterations against 173, the tracked
+    /// displacements equal to 1e-15.
+    Amg { rtol: Scalar, symmetric: bool },
     /// Right-preconditioned GMRES with an upper block-triangular Schur-complement field split,
     /// for the mixed P2–P1 saddle point: GAMG on the displacement block (its index set carries
     /// the rigid-body near-null space), and on the Schur complement `pressure_mass`, the
@@ -183,8 +189,12 @@ impl LinearSolver<'_> {
                         "PCFactorSetMatSolverType",
                     )?;
                 }
-                LinearSolver::Amg { rtol } => {
-                    krylov(ksp, *rtol)?;
+                LinearSolver::Amg { rtol, symmetric } => {
+                    if *symmetric {
+                        conjugate_gradients(ksp, *rtol)?;
+                    } else {
+                        krylov(ksp, *rtol)?;
+                    }
                     set_pc_type(pc, "gamg")?;
                     // native-stack.md pitfall 4: reused GAMG interpolation once gave an
                     // indefinite preconditioner on the second Newton iteration.
@@ -255,6 +265,27 @@ unsafe fn krylov(ksp: ffi::KSP, rtol: Scalar) -> Result<(), PetscError> {
         "KSPGMRESSetRestart",
     )?;
     check(ffi::KSPSetPCSide(ksp, ffi::PCSide_PC_RIGHT), "KSPSetPCSide")?;
+    check(
+        ffi::KSPSetTolerances(
+            ksp,
+            rtol,
+            1e-50,
+            ffi::PETSC_DEFAULT as Scalar,
+            to_int(MAX_LINEAR_IT, "KSP iterations")?,
+        ),
+        "KSPSetTolerances",
+    )
+}
+
+/// CG, left-preconditioned (as CG must be) but converged on the unpreconditioned residual,
+/// so that `rtol` means what it means for [`krylov`].
+unsafe fn conjugate_gradients(ksp: ffi::KSP, rtol: Scalar) -> Result<(), PetscError> {
+    set_ksp_type(ksp, "cg")?;
+    check(ffi::KSPSetPCSide(ksp, ffi::PCSide_PC_LEFT), "KSPSetPCSide")?;
+    check(
+        ffi::KSPSetNormType(ksp, ffi::KSPNormType_KSP_NORM_UNPRECONDITIONED),
+        "KSPSetNormType",
+    )?;
     check(
         ffi::KSPSetTolerances(
             ksp,

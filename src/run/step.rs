@@ -302,7 +302,10 @@ impl Simulation {
                 pressure: &s.pressure_field,
                 pressure_mass: &s.pressure_mass,
             },
-            None if iterative => LinearSolver::Amg { rtol: AMG_RTOL },
+            None if iterative => LinearSolver::Amg {
+                rtol: AMG_RTOL,
+                symmetric: self.symmetric_tangent(),
+            },
             None => LinearSolver::Direct {
                 reuse: crate::petsc::FactorReuse::from_options(solver.reuse_factorisation)?,
                 symmetric: self.symmetric_tangent(),
@@ -336,7 +339,8 @@ impl Simulation {
     /// geometric stiffness of a hyperelastic step are), with dead loads only (point loads and
     /// gravity keep their direction; follower pressures and contact do not) and prescribed
     /// displacements eliminated symmetrically. `solver.symmetric = false` or the PETSc options
-    /// `-pc_type lu -pc_factor_mat_solver_type mumps` factor LU anyway.
+    /// `-pc_type lu -pc_factor_mat_solver_type mumps` factor LU anyway (and keep GMRES on the
+    /// iterative path).
     fn symmetric_tangent(&self) -> bool {
         let m = &self.model;
         m.scene.solver.symmetric
@@ -401,6 +405,9 @@ impl Simulation {
         } = objects;
         let mut problem =
             StepProblem::new(world, mesh, dofs, setup, x).map_err(|e| err(e.to_string()))?;
+        if *amg || split.is_some() {
+            problem = problem.without_element_cache();
+        }
         if let Some(split) = split {
             problem = problem.with_schur_preconditioner(SchurPreconditioner {
                 matrix: &split.pressure_mass,

@@ -360,13 +360,15 @@ pub struct Solver {
     /// every `"p2p1"` mesh, iterative for larger `"p2"` meshes; measured on a 2-core machine,
     /// the direct path was faster at every size that fits, and the limit is its memory),
     /// `"direct"` (MUMPS LU) or `"iterative"`
-    /// (GMRES with algebraic multigrid for `"p2"`; with a Schur-complement field split, AMG on
+    /// (GMRES, or CG where `symmetric` applies, with algebraic multigrid for `"p2"`; with a Schur-complement field split, AMG on
     /// the displacements and the pressure mass matrix scaled by 1/G on the pressures, for
     /// `"p2p1"`). PETSc options on the command line (`-ksp_type`, `-pc_type`, ...) override it.
     pub linear: LinearChoice,
-    /// Whether the direct solver factors LDLᵀ (MUMPS) instead of LU where every tangent is
-    /// symmetric: an elastic `"p2"` scene without rigid bodies or surface pressures. Half the
-    /// factor's entries and flops; the history is LU's to round-off. Default true.
+    /// Whether the direct solver factors LDLᵀ (MUMPS) instead of LU, and the iterative one
+    /// uses conjugate gradients instead of GMRES, where every tangent is symmetric: an elastic
+    /// `"p2"` scene without rigid bodies or surface pressures. Half the factor's entries and
+    /// flops; a few Krylov vectors instead of one per iteration; the history is LU's (GMRES's)
+    /// to round-off. Default true.
     pub symmetric: bool,
     /// Whether the direct solver keeps a factorisation for the next Newton iteration while
     /// Newton converges fast, solving the exact tangent with GCR preconditioned by it

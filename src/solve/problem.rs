@@ -59,7 +59,8 @@ pub struct Augmentation {
     pub switched: usize,
 }
 
-/// One element's contribution: residual, row-major tangent, states; dof order as the element's.
+/// One element's contribution: residual, row-major tangent (empty where only the residual and
+/// states were asked for), states; dof order as the element's.
 pub struct ElementResult {
     pub residual: Vec<f64>,
     pub tangent: Vec<f64>,
@@ -88,7 +89,12 @@ pub struct StepProblem<'a> {
     /// pass over the elements (measured on the cantilever at h = 1/32: 75 element passes for
     /// 35 Newton iterations, now 40). The elements do not depend on the contact multipliers
     /// (`augment`), so a hit is exact.
+    /// Kept only with `keep_elements`: on the iterative path the tangents of every triangle
+    /// (1.2 kB each, 3 kB per particle) would sit beside the AMG hierarchy and the Krylov
+    /// vectors at the memory peak, so there the Jacobian evaluates the elements again and
+    /// assembles them one at a time (one more element pass per Newton iteration).
     cache: RefCell<Option<(Vec<f64>, Vec<ElementResult>)>>,
+    keep_elements: bool,
     /// Per triangle, `n` global columns in increasing order and, for each, its element dof:
     /// PETSc's MatSetValues searches a row's columns from the last one found, so sorted
     /// columns make each search short.
@@ -155,6 +161,7 @@ impl<'a> StepProblem<'a> {
             diagonal: Cell::new(None),
             schur: None,
             cache: RefCell::new(None),
+            keep_elements: true,
             sorted_cols,
             sorted_dofs,
         })
@@ -163,6 +170,13 @@ impl<'a> StepProblem<'a> {
     /// Assembles `schur` with every Jacobian (mixed kernels only).
     pub fn with_schur_preconditioner(mut self, schur: SchurPreconditioner<'a>) -> Self {
         self.schur = Some(schur);
+        self
+    }
+
+    /// Evaluates the elements afresh for every residual and Jacobian instead of keeping the
+    /// last residual's (see `cache`).
+    pub fn without_element_cache(mut self) -> Self {
+        self.keep_elements = false;
         self
     }
 
@@ -231,12 +245,16 @@ impl<'a> StepProblem<'a> {
     }
 
     /// Evaluates every local triangle at the local vector `local` (the last residual's results
-    /// when it was evaluated there).
+    /// when it was evaluated there). Without the element cache the tangents are left empty:
+    /// the caller reads residuals and states only.
     pub fn elements(&self, local: &[f64]) -> Result<Vec<ElementResult>, String> {
-        match self.cached(local) {
-            Some(elems) => Ok(elems),
-            None => self.evaluate_elements(local),
+        if let Some(elems) = self.cached(local) {
+            return Ok(elems);
         }
+        let tangent = self.keep_elements;
+        (0..self.element_dofs.len())
+            .map(|t| self.evaluate_element(t, local, tangent))
+            .collect()
     }
 
     /// The cached element results if they were evaluated at exactly `local` (bit for bit);
@@ -251,82 +269,128 @@ impl<'a> StepProblem<'a> {
         same.then_some(elems)
     }
 
-    fn evaluate_elements(&self, local: &[f64]) -> Result<Vec<ElementResult>, String> {
+    /// Triangle `t` at the local vector `local`, with its tangent if `tangent`.
+    fn evaluate_element(
+        &self,
+        t: usize,
+        local: &[f64],
+        tangent: bool,
+    ) -> Result<ElementResult, String> {
         let s = &self.setup;
-        let mut out = Vec::with_capacity(self.mesh.tris.len());
-        for (t, dofs) in self.element_dofs.iter().enumerate() {
-            let du: [[f64; 2]; 6] =
-                std::array::from_fn(|k| [local[dofs[2 * k]], local[dofs[2 * k + 1]]]);
-            let result = match s.kernel {
-                Kernel::P2 => p2_element(
+        let dofs = &self.element_dofs[t];
+        let du: [[f64; 2]; 6] =
+            std::array::from_fn(|k| [local[dofs[2 * k]], local[dofs[2 * k + 1]]]);
+        let flat = |k: &[f64]| if tangent { k.to_vec() } else { Vec::new() };
+        let result = match s.kernel {
+            Kernel::P2 => p2_element(
+                &self.geometry[t],
+                &du,
+                &s.states_n[t],
+                s.material,
+                s.body_force,
+            )
+            .map(|e| ElementResult {
+                residual: e.residual.to_vec(),
+                tangent: flat(e.tangent.as_flattened()),
+                states: e.states,
+            }),
+            Kernel::P2P1 { bulk, scale } => {
+                let p: [f64; 3] = std::array::from_fn(|k| scale * local[dofs[12 + k]]);
+                p2p1_element(
                     &self.geometry[t],
                     &du,
+                    &p,
                     &s.states_n[t],
                     s.material,
+                    bulk,
                     s.body_force,
                 )
-                .map(|e| ElementResult {
-                    residual: e.residual.to_vec(),
-                    tangent: e.tangent.as_flattened().to_vec(),
-                    states: e.states,
-                }),
-                Kernel::P2P1 { bulk, scale } => {
-                    let p: [f64; 3] = std::array::from_fn(|k| scale * local[dofs[12 + k]]);
-                    p2p1_element(
-                        &self.geometry[t],
-                        &du,
-                        &p,
-                        &s.states_n[t],
-                        s.material,
-                        bulk,
-                        s.body_force,
-                    )
-                    .map(|e| {
-                        let e = e.with_pressure_scale(scale);
-                        ElementResult {
-                            residual: e.residual.to_vec(),
-                            tangent: e.tangent.as_flattened().to_vec(),
-                            states: e.states,
-                        }
-                    })
-                }
-            };
-            out.push(result.map_err(|e| format!("triangle {:?}: {e}", self.mesh.tri_key(t)))?);
-        }
-        Ok(out)
+                .map(|e| {
+                    let e = e.with_pressure_scale(scale);
+                    ElementResult {
+                        residual: e.residual.to_vec(),
+                        tangent: flat(e.tangent.as_flattened()),
+                        states: e.states,
+                    }
+                })
+            }
+        };
+        result.map_err(|e| format!("triangle {:?}: {e}", self.mesh.tri_key(t)))
     }
 
-    /// Collective: all ranks learn whether any element failed, so they fail together.
-    fn evaluate(&self, x: VecRef<'_>) -> Result<(Vec<f64>, Vec<ElementResult>), CallbackError> {
+    /// Collective. Hands every local triangle at `x`, in order, to `each` (the cached results
+    /// when the last residual was evaluated at `x`), with the local vector; all ranks learn
+    /// whether any element failed, so they fail together (`each` may then have seen only some
+    /// triangles). The first evaluation of the increment also fixes the constrained diagonal.
+    /// `store`: keep the results for the next evaluation at the same `x` (with `keep_elements`).
+    fn evaluate(
+        &self,
+        x: VecRef<'_>,
+        store: bool,
+        mut each: impl FnMut(usize, &ElementResult) -> Result<(), CallbackError>,
+    ) -> Result<Vec<f64>, CallbackError> {
         let local = self
             .local_values(x)
             .map_err(|e| CallbackError::Fatal(e.to_string()))?;
-        // Every rank takes part in the agreement, hit or miss, so the collective calls match.
-        let elems = self.elements(&local);
-        match agree_on_error(self.comm, elems.as_ref().err().cloned()) {
-            None => {
-                let elems = elems.map_err(CallbackError::Domain)?;
-                if self.diagonal.get().is_none() {
-                    self.diagonal.set(Some(self.mean_free_diagonal(&elems)));
-                }
-                Ok((local, elems))
+        let first = self.diagonal.get().is_none();
+        let mut diagonal_sum = 0.0;
+        let mut keep = Vec::new();
+        let cached = self.cached(&local);
+        let mut failed = None;
+        let store = store && self.keep_elements;
+        for t in 0..self.element_dofs.len() {
+            let fresh = match cached {
+                Some(_) => None,
+                None => match self.evaluate_element(t, &local, true) {
+                    Ok(e) => Some(e),
+                    Err(msg) => {
+                        failed = Some(msg);
+                        break;
+                    }
+                },
+            };
+            let e = match (&fresh, &cached) {
+                (Some(e), _) => e,
+                (None, Some(elems)) => &elems[t],
+                (None, None) => unreachable!("a triangle is either cached or evaluated"),
+            };
+            if first {
+                self.add_free_diagonal(t, e, &mut diagonal_sum);
             }
-            Some(msg) => Err(CallbackError::Domain(msg)),
+            each(t, e)?;
+            if let (Some(e), true) = (fresh, store) {
+                keep.push(e);
+            }
+        }
+        // Every rank takes part in the agreement, hit or miss, so the collective calls match.
+        if let Some(msg) = agree_on_error(self.comm, failed) {
+            return Err(CallbackError::Domain(msg));
+        }
+        if first {
+            self.diagonal
+                .set(Some(self.mean_free_diagonal(diagonal_sum)));
+        }
+        if store {
+            *self.cache.borrow_mut() = Some((local.clone(), cached.unwrap_or(keep)));
+        }
+        Ok(local)
+    }
+
+    /// Adds the diagonal entries of the free displacement rows of triangle `t`'s tangent to
+    /// `sum` one by one (the order of the sum is the triangles' and rows', whatever the cache).
+    fn add_free_diagonal(&self, t: usize, e: &ElementResult, sum: &mut f64) {
+        let n = e.residual.len();
+        for k in 0..12 {
+            if self.free_row(t, k).is_some() {
+                *sum += e.tangent[k * n + k];
+            }
         }
     }
 
-    /// Collective. The mean diagonal of the free displacement rows of the tangent `elems`
-    /// (without contact and surface loads; 1 when no row is free).
-    fn mean_free_diagonal(&self, elems: &[ElementResult]) -> f64 {
-        let mut sums = [0.0; 2];
-        for (t, e) in elems.iter().enumerate() {
-            let n = e.residual.len();
-            for k in 0..12 {
-                if self.free_row(t, k).is_some() {
-                    sums[0] += e.tangent[k * n + k];
-                }
-            }
-        }
+    /// Collective. The mean diagonal of the free displacement rows of the tangent, from this
+    /// rank's sum of them (without contact and surface loads; 1 when no row is free).
+    fn mean_free_diagonal(&self, diagonal_sum: f64) -> f64 {
+        let mut sums = [diagonal_sum, 0.0];
         for n in 0..self.dofs.n_nodes() {
             for c in 0..2 {
                 if self.free(n, c) {
@@ -560,18 +624,24 @@ impl StepProblem<'_> {
 
 impl NonlinearProblem for StepProblem<'_> {
     fn residual(&mut self, x: VecRef<'_>, f: VecRef<'_>) -> Result<(), CallbackError> {
-        let (local, elems) = self.evaluate(x)?;
         let first = self.dofs.first_dof;
-        let diagonal = self.constrained_diagonal();
+        let mut evaluated = Ok(Vec::new());
         f.write(|fa| {
             fa.fill(0.0);
-            for (t, e) in elems.iter().enumerate() {
+            evaluated = self.evaluate(x, true, |t, e| {
                 for (k, r) in e.residual.iter().enumerate() {
                     if let Some(row) = self.free_row(t, k) {
                         fa[row] += r;
                     }
                 }
-            }
+                Ok(())
+            });
+        })
+        .map_err(|e| CallbackError::Fatal(e.to_string()))?;
+        let local = evaluated?;
+        // Read after the evaluation: the first one of the increment fixes it.
+        let diagonal = self.constrained_diagonal();
+        f.write(|fa| {
             self.external(&local, |n, c, v| {
                 if self.free(n, c) {
                     fa[self.dofs.node_global[n] - first + c] -= v;
@@ -598,12 +668,10 @@ impl NonlinearProblem for StepProblem<'_> {
             }
         })
         .map_err(|e| CallbackError::Fatal(e.to_string()))?;
-        *self.cache.borrow_mut() = Some((local, elems));
         Ok(())
     }
 
     fn jacobian(&mut self, x: VecRef<'_>, j: MatRef<'_>) -> Result<(), CallbackError> {
-        let (local, elems) = self.evaluate(x)?;
         let fatal = |e: PetscError| CallbackError::Fatal(e.to_string());
         let l2g = self
             .dofs
@@ -616,7 +684,7 @@ impl NonlinearProblem for StepProblem<'_> {
         let mut rows = Vec::new();
         let mut vals = Vec::new();
         let mut start = 0;
-        for (t, e) in elems.iter().enumerate() {
+        let evaluated = self.evaluate(x, false, |t, e| {
             let n = e.residual.len();
             let cols = &self.sorted_cols[start..start + n];
             let order = &self.sorted_dofs[start..start + n];
@@ -645,7 +713,17 @@ impl NonlinearProblem for StepProblem<'_> {
             if !rows.is_empty() {
                 j.add_values(&rows, cols, &vals).map_err(fatal)?;
             }
-        }
+            Ok(())
+        });
+        let local = match evaluated {
+            Ok(local) => local,
+            Err(CallbackError::Domain(msg)) => {
+                // Every rank failed alike: leave the matrix assembled for the next attempt.
+                j.assemble().map_err(fatal)?;
+                return Err(CallbackError::Domain(msg));
+            }
+            Err(e) => return Err(e),
+        };
         self.external_tangent(&local, |r, c, v| j.add_values(&[r], &[c], &[v]))
             .map_err(fatal)?;
         let diagonal = self.constrained_diagonal();
