@@ -153,16 +153,7 @@ impl LinearSolver<'_> {
                         // costs one triangular solve, as with `preonly`.
                         Some(r) => {
                             set_ksp_type(ksp, "gcr")?;
-                            check(
-                                ffi::KSPSetTolerances(
-                                    ksp,
-                                    r.rtol,
-                                    1e-50,
-                                    ffi::PETSC_DEFAULT as Scalar,
-                                    to_int(MAX_LINEAR_IT, "KSP iterations")?,
-                                ),
-                                "KSPSetTolerances",
-                            )?;
+                            tolerances(ksp, r.rtol)?;
                         }
                         None => set_ksp_type(ksp, "preonly")?,
                     }
@@ -265,16 +256,7 @@ unsafe fn krylov(ksp: ffi::KSP, rtol: Scalar) -> Result<(), PetscError> {
         "KSPGMRESSetRestart",
     )?;
     check(ffi::KSPSetPCSide(ksp, ffi::PCSide_PC_RIGHT), "KSPSetPCSide")?;
-    check(
-        ffi::KSPSetTolerances(
-            ksp,
-            rtol,
-            1e-50,
-            ffi::PETSC_DEFAULT as Scalar,
-            to_int(MAX_LINEAR_IT, "KSP iterations")?,
-        ),
-        "KSPSetTolerances",
-    )
+    tolerances(ksp, rtol)
 }
 
 /// CG, left-preconditioned (as CG must be) but converged on the unpreconditioned residual,
@@ -286,6 +268,12 @@ unsafe fn conjugate_gradients(ksp: ffi::KSP, rtol: Scalar) -> Result<(), PetscEr
         ffi::KSPSetNormType(ksp, ffi::KSPNormType_KSP_NORM_UNPRECONDITIONED),
         "KSPSetNormType",
     )?;
+    tolerances(ksp, rtol)
+}
+
+/// `rtol` relative to the first residual, no absolute floor, at most [`MAX_LINEAR_IT`]
+/// iterations.
+unsafe fn tolerances(ksp: ffi::KSP, rtol: Scalar) -> Result<(), PetscError> {
     check(
         ffi::KSPSetTolerances(
             ksp,
