@@ -54,11 +54,14 @@ impl Simulation {
         };
         let lambda = self.header.load_factor;
         let bodies: Vec<_> = self.model.bodies.iter().map(|b| b.shape(lambda)).collect();
-        let slides = |p: usize| {
+        // Signed distance to the nearest body (negative inside; infinite without bodies).
+        let gap = |x: [f64; 2]| {
             bodies
                 .iter()
-                .any(|s| s.closest(mesh.points[p]).distance <= SLIDING_GAP * mesh.h[p])
+                .map(|s| s.closest(x).distance)
+                .fold(f64::INFINITY, f64::min)
         };
+        let slides = |p: usize| gap(mesh.points[p]) <= SLIDING_GAP * mesh.h[p];
         // A particle held in one direction only (a symmetry plane) near a body: its distance
         // to the body. Read for ghosts too, from their reference positions, as every rank
         // holding the point has them bit for bit.
@@ -72,22 +75,11 @@ impl Simulation {
                 lambda,
                 lambda,
             );
-            (bc.iter().filter(|c| c.is_some()).count() == 1).then(|| {
-                bodies
-                    .iter()
-                    .map(|s| s.closest(mesh.points[p]).distance)
-                    .fold(f64::INFINITY, f64::min)
-            })
+            (bc.iter().filter(|c| c.is_some()).count() == 1).then(|| gap(mesh.points[p]))
         };
         let mut plan = plan(mesh, protected, slides, support_gap, &params);
         if settings.refine && !bodies.is_empty() {
-            let depth = |x: [f64; 2]| {
-                bodies
-                    .iter()
-                    .map(|s| -s.closest(x).distance)
-                    .fold(f64::NEG_INFINITY, f64::max)
-            };
-            for e in deep_chords(mesh, depth, MAX_CHORD_DEPTH, MIN_CHORD_SPLIT) {
+            for e in deep_chords(mesh, |x| -gap(x), MAX_CHORD_DEPTH, MIN_CHORD_SPLIT) {
                 if !plan.split.contains(&e) {
                     plan.split.push(e);
                 }

@@ -359,8 +359,8 @@ pub struct Solver {
     /// Newton's linear solver: `"auto"` (default: direct up to 2 million global dofs and for
     /// every `"p2p1"` mesh, iterative for larger `"p2"` meshes; measured on a 2-core machine,
     /// the direct path was faster at every size that fits, and the limit is its memory),
-    /// `"direct"` (MUMPS LU) or `"iterative"`
-    /// (GMRES, or CG where `symmetric` applies, with algebraic multigrid for `"p2"`; with a Schur-complement field split, AMG on
+    /// `"direct"` (MUMPS LU) or `"iterative"` (GMRES, or CG where `symmetric` applies, with
+    /// algebraic multigrid for `"p2"`; with a Schur-complement field split, AMG on
     /// the displacements and the pressure mass matrix scaled by 1/G on the pressures, for
     /// `"p2p1"`). PETSc options on the command line (`-ksp_type`, `-pc_type`, ...) override it.
     pub linear: LinearChoice,

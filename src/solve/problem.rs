@@ -319,52 +319,63 @@ impl<'a> StepProblem<'a> {
     }
 
     /// Collective. Hands every local triangle at `x`, in order, to `each` (the cached results
-    /// when the last residual was evaluated at `x`), with the local vector; all ranks learn
-    /// whether any element failed, so they fail together (`each` may then have seen only some
-    /// triangles). The first evaluation of the increment also fixes the constrained diagonal.
-    /// `store`: keep the results for the next evaluation at the same `x` (with `keep_elements`).
+    /// when the last residual was evaluated at `x`), with the local vector. A failing element
+    /// or `each` stops the pass, and all ranks learn of it, so they fail together and of the
+    /// same kind (`each` may then have seen only some triangles). The first evaluation of the
+    /// increment also fixes the constrained diagonal. For the residual (`jacobian` false) the
+    /// results are kept for the Jacobian at the same `x` (with `keep_elements`); tangents are
+    /// computed only where they are read.
     fn evaluate(
         &self,
         x: VecRef<'_>,
-        store: bool,
+        jacobian: bool,
         mut each: impl FnMut(usize, &ElementResult) -> Result<(), CallbackError>,
     ) -> Result<Vec<f64>, CallbackError> {
         let local = self
             .local_values(x)
             .map_err(|e| CallbackError::Fatal(e.to_string()))?;
         let first = self.diagonal.get().is_none();
+        let store = !jacobian && self.keep_elements;
+        let tangent = jacobian || first || store;
         let mut diagonal_sum = 0.0;
         let mut keep = Vec::new();
         let cached = self.cached(&local);
         let mut failed = None;
-        let store = store && self.keep_elements;
         for t in 0..self.element_dofs.len() {
-            let fresh = match cached {
-                Some(_) => None,
-                None => match self.evaluate_element(t, &local, true) {
-                    Ok(e) => Some(e),
+            let mut fresh = None;
+            let e: &ElementResult = match &cached {
+                Some(elems) => &elems[t],
+                None => match self.evaluate_element(t, &local, tangent) {
+                    Ok(e) => fresh.insert(e),
                     Err(msg) => {
-                        failed = Some(msg);
+                        failed = Some(CallbackError::Domain(msg));
                         break;
                     }
                 },
             };
-            let e = match (&fresh, &cached) {
-                (Some(e), _) => e,
-                (None, Some(elems)) => &elems[t],
-                (None, None) => unreachable!("a triangle is either cached or evaluated"),
-            };
             if first {
                 self.add_free_diagonal(t, e, &mut diagonal_sum);
             }
-            each(t, e)?;
-            if let (Some(e), true) = (fresh, store) {
-                keep.push(e);
+            if let Err(err) = each(t, e) {
+                failed = Some(err);
+                break;
+            }
+            if store {
+                keep.extend(fresh);
             }
         }
-        // Every rank takes part in the agreement, hit or miss, so the collective calls match.
-        if let Some(msg) = agree_on_error(self.comm, failed) {
-            return Err(CallbackError::Domain(msg));
+        // Every rank takes part in the agreement, hit or miss, so the collective calls match;
+        // the kind travels as the message's first character.
+        let encoded = failed.map(|e| match e {
+            CallbackError::Domain(m) => format!("D{m}"),
+            CallbackError::Fatal(m) => format!("F{m}"),
+        });
+        if let Some(agreed) = agree_on_error(self.comm, encoded) {
+            let (kind, msg) = agreed.split_at(1);
+            return Err(match kind {
+                "F" => CallbackError::Fatal(msg.to_string()),
+                _ => CallbackError::Domain(msg.to_string()),
+            });
         }
         if first {
             self.diagonal
@@ -628,7 +639,7 @@ impl NonlinearProblem for StepProblem<'_> {
         let mut evaluated = Ok(Vec::new());
         f.write(|fa| {
             fa.fill(0.0);
-            evaluated = self.evaluate(x, true, |t, e| {
+            evaluated = self.evaluate(x, false, |t, e| {
                 for (k, r) in e.residual.iter().enumerate() {
                     if let Some(row) = self.free_row(t, k) {
                         fa[row] += r;
@@ -684,7 +695,7 @@ impl NonlinearProblem for StepProblem<'_> {
         let mut rows = Vec::new();
         let mut vals = Vec::new();
         let mut start = 0;
-        let evaluated = self.evaluate(x, false, |t, e| {
+        let evaluated = self.evaluate(x, true, |t, e| {
             let n = e.residual.len();
             let cols = &self.sorted_cols[start..start + n];
             let order = &self.sorted_dofs[start..start + n];
