@@ -11,6 +11,7 @@ use crate::petsc::{
 use crate::scene::{LineSearch, LinearChoice};
 use crate::solve::nullspace::orthonormal_rigid_body_modes;
 use crate::solve::{Constraints, DofMap, FieldLayout, SchurPreconditioner, StepProblem, StepSetup};
+use mpi::traits::Communicator;
 use pfem_partition::{max_f64, sum_f64, Comm};
 
 /// PETSc objects reused across increments with the same matrix pattern.
@@ -295,9 +296,12 @@ impl Simulation {
         } else {
             None
         };
+        // Past the size where `auto` turns iterative to save memory, memory keeps the lead.
+        let lean = world.size() > 1 && dofs.n_global_dofs > ITERATIVE_ABOVE_DOFS;
         let linear = match &split {
             Some(s) => LinearSolver::Schur {
                 rtol: SCHUR_RTOL,
+                lean,
                 displacement: &s.displacement_field,
                 pressure: &s.pressure_field,
                 pressure_mass: &s.pressure_mass,
@@ -305,6 +309,7 @@ impl Simulation {
             None if iterative => LinearSolver::Amg {
                 rtol: AMG_RTOL,
                 symmetric: self.symmetric_tangent(),
+                lean,
             },
             None => LinearSolver::Direct {
                 reuse: crate::petsc::FactorReuse::from_options(solver.reuse_factorisation)?,
