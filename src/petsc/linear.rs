@@ -55,7 +55,7 @@ pub enum LinearSolver<'a> {
 /// on the cantilever, 2 ranks, iterative, one step (Newton and CG iterations the same with
 /// either): peak RSS summed over the ranks at h = 1/64 (41 665 particles) 684 → 499 MB, at
 /// 1/128 (165 249) 2 461 → 1 727 MB, about what one rank needs (456 and 1 558 MB); at 1.03 M
-/// particles 10.3 GB (about 15 GB expected without). The price is time: the products took
+/// particles 10 255 MB (about 15 GB expected without). The price is time: the products took
 /// 19–22 s instead of 3.0–3.7 s at 1/64, 234 s of the 1.03 M step's 502 s of solve. A
 /// process option: once a run has set it, it keeps it, and the command line wins
 /// (`-matptap_via`). Only MPI matrices know the algorithm, so it is never set on one rank.
