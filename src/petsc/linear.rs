@@ -160,6 +160,12 @@ impl LinearSolver<'_> {
         let mut pc: ffi::PC = std::ptr::null_mut();
         // SAFETY: `ksp` is the live KSP of a SNES we own; the PC is borrowed from it. Index
         // sets and matrices handed to the PC are referenced by PETSc, not taken over.
+        if matches!(
+            self,
+            LinearSolver::Amg { lean: true, .. } | LinearSolver::Schur { lean: true, .. }
+        ) {
+            default_option(LEAN_PTAP.0, LEAN_PTAP.1)?;
+        }
         unsafe {
             check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
             match self {
@@ -198,13 +204,8 @@ impl LinearSolver<'_> {
                     )?;
                 }
                 LinearSolver::Amg {
-                    rtol,
-                    symmetric,
-                    lean,
+                    rtol, symmetric, ..
                 } => {
-                    if *lean {
-                        default_option(LEAN_PTAP.0, LEAN_PTAP.1)?;
-                    }
                     if *symmetric {
                         conjugate_gradients(ksp, *rtol)?;
                     } else {
@@ -220,14 +221,11 @@ impl LinearSolver<'_> {
                 }
                 LinearSolver::Schur {
                     rtol,
-                    lean,
                     displacement,
                     pressure,
                     pressure_mass,
+                    ..
                 } => {
-                    if *lean {
-                        default_option(LEAN_PTAP.0, LEAN_PTAP.1)?;
-                    }
                     krylov(ksp, *rtol)?;
                     set_pc_type(pc, "fieldsplit")?;
                     let (u, p) = (cstring("u")?, cstring("p")?);
