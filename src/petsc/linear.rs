@@ -157,15 +157,15 @@ impl LinearSolver<'_> {
 
     /// Collective. Configures `ksp` (borrowed from a SNES).
     pub(crate) fn configure(&self, ksp: ffi::KSP) -> Result<(), PetscError> {
-        let mut pc: ffi::PC = std::ptr::null_mut();
-        // SAFETY: `ksp` is the live KSP of a SNES we own; the PC is borrowed from it. Index
-        // sets and matrices handed to the PC are referenced by PETSc, not taken over.
         if matches!(
             self,
             LinearSolver::Amg { lean: true, .. } | LinearSolver::Schur { lean: true, .. }
         ) {
             default_option(LEAN_PTAP.0, LEAN_PTAP.1)?;
         }
+        let mut pc: ffi::PC = std::ptr::null_mut();
+        // SAFETY: `ksp` is the live KSP of a SNES we own; the PC is borrowed from it. Index
+        // sets and matrices handed to the PC are referenced by PETSc, not taken over.
         unsafe {
             check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
             match self {
