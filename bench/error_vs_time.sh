@@ -18,7 +18,7 @@
 #   tbar-smooth/-rough mean Nc over w = 0.1D..0.25D of a 0.25D push against 9.142 / 11.940
 #   footing            q/cu at z/B = 0.1 (a 0.2 m push), against a Richardson value from the sweep
 #   pipeline           V/(D cu) at w = 0.25D (a 0.01 m push), against a Richardson value from the sweep
-# Every run is under `nice -n 10` and a `timeout` (TIMEOUT s of wall). Once the iterative path
+# Every run is under `nice -n 19` and a `timeout` (TIMEOUT s of wall). Once the iterative path
 # fails on a rank count (in this or an earlier invocation, as recorded in the CSV), its further
 # settings are recorded as not run: a sweep runs from cheap to expensive. A run stopped by
 # the solver is recorded with its reason; its error is not counted.
@@ -78,7 +78,7 @@ source bench/setup.sh "error_vs_time_$scene${WORK_TAG:+_$WORK_TAG}"
 start=$(date +%s)
 failed_iterative=" "
 echo "$scene: factors $factors, steps $steps, ranks $ranks_list, paths $paths (timeout $timeout s, budget $budget s)"
-echo "FACTORS=\"$factors\" STEPS=\"$steps\" RANKS=\"$ranks_list\" PATHS=\"$paths\" bench/error_vs_time.sh $scene" \
+echo "FACTORS=\"$factors\" STEPS=\"$steps\" RANKS=\"$ranks_list\" PATHS=\"$paths\" TIMEOUT=$timeout bench/error_vs_time.sh $scene" \
   >>"$results/$scene.commands"
 
 for f in $factors; do
@@ -125,7 +125,7 @@ for f in $factors; do
         t0=$(date +%s.%N)
         code=0
         # Each rank under /usr/bin/time: user + system CPU s and peak RSS per rank.
-        nice -n 10 timeout -k 30 "$limit" mpirun -n "$ranks" sh -c \
+        nice -n 19 timeout -k 30 "$limit" mpirun -n "$ranks" sh -c \
           'exec /usr/bin/time -f "%U %S %M" -o "$0.time.$OMPI_COMM_WORLD_RANK" "$@"' "$run" \
           "$bin" "$name.h5" --out "$run.out" >"$run.log" 2>&1 || code=$?
         t1=$(date +%s.%N)
