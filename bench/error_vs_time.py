@@ -154,7 +154,7 @@ def measure(scene, rows):
         note = f"q/cu against h/2 at z/B {note}" if note else f"z/B {zmax:.4g}"
         q1 = interp(rows, "z_over_B", "q_over_cu", 1.0)
         err = max(abs(errs[z]) for z in FOOTING_DEPTHS) if all(z in errs for z in FOOTING_DEPTHS) else None
-        return (q1 if q1 is not None else float(last["q_over_cu"])), errs.get(0.1, ""), err, note
+        return ("" if q1 is None else q1), errs.get(0.1, ""), err, note
     if scene == "pipeline":
         return float(last["V_over_Dcu"]), float(last["uy_over_D"]), None, f"w/D {float(last['uy_over_D']):.4g}"
     raise SystemExit(f"unknown scene {scene}")
@@ -182,7 +182,7 @@ def record(path, args):
         if os.path.exists(hist) and len(history(hist)) > 0:
             rows = history(hist)
             value, value2, err, note = measure(row["scene"], rows)
-            row.update(value=fmt(value), value2=fmt(value2) if value2 != "" else "", note=note)
+            row.update(value=fmt(value) if value != "" else "", value2=fmt(value2) if value2 != "" else "", note=note)
             # A run that stopped early is judged at the step it reached, and its error not
             # counted (it did not compute what was asked).
             if status == "ok" and err is not None:
@@ -368,7 +368,7 @@ def report(scene, path, out):
         if scene == "footing" and r["value2"] != "":
             value2 = f"{100 * float(r['value2']):+.2f} %"
         status = r["status"] if not r["note"] or r["status"] == "ok" else f"{r['status']} ({r['note']})"
-        if r["status"] == "ok" and r["note"] and scene in ("tbar-smooth", "tbar-rough"):
+        if r["status"] == "ok" and r["note"] and scene in ("tbar-smooth", "tbar-rough", "footing"):
             status = f"ok ({r['note']})"
         lines.append(
             f"| {float(r['factor']):g} | {float(r['h_min']):.4g} | {r['steps']} | {r['particles'] or '–'} | "
