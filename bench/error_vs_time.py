@@ -202,6 +202,10 @@ def record(path, args):
         w.writerows(rows)
 
 
+# Set by richardson() when the finest value is the reference: its relative uncertainty (plotted).
+UNCERTAINTY = [None]
+
+
 def richardson(rows):
     """Reference from the sweep itself: the direct runs of one step count (the largest that most
     spacings finished; 1 rank preferred), extrapolated in the spacing. Returns (value, text)."""
@@ -237,11 +241,13 @@ def richardson(rows):
                 p, how = p_obs, f"observed order {p_obs:.2f} from three spacings (monotone)"
             else:
                 ref = q0
+                UNCERTAINTY[0] = abs(d01 / q0)
                 how = (f"the observed order {p_obs:.2f} from three spacings is outside 0.5-3: the finest "
                        f"value is the reference, uncertain by the finest-to-middle difference "
                        f"{100 * abs(d01 / q0):.2g} %")
         else:
             ref = q0
+            UNCERTAINTY[0] = abs(d01 / q0)
             how = (f"the three spacings do not converge monotonically "
                    f"({'increments of opposite sign' if d01 * d12 <= 0 else 'increments not shrinking'}): "
                    f"the finest value is the reference, uncertain by the finest-to-middle difference "
@@ -408,6 +414,10 @@ def plot(scene, rows, png, name):
              ("1", "iterative"): ("^", "C2"), ("2", "iterative"): ("D", "C3")}
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), sharey=True)
     ok = [r for r in rows if r["status"] == "ok" and r["error"] and r["cpu_s"]]
+    if UNCERTAINTY[0] is not None:
+        # The reference run itself (error 0) has no place on a log axis: left out, the reference's
+        # uncertainty drawn instead.
+        ok = [r for r in ok if float(r["error"]) > 0]
     errs = [max(float(r["error"]), 1e-13) for r in ok]
     top = max(errs + [0.02]) * 3
     for ax, col, xlabel in ((axes[0], "cpu_s", "CPU s (summed over ranks)"),
@@ -429,6 +439,10 @@ def plot(scene, rows, png, name):
         if front:
             ax.plot([p[0] for p in front], [p[1] for p in front], "k-", lw=1, zorder=2, label="Pareto front")
         ax.axhline(0.01, color="grey", ls="--", lw=0.8, label="1 %")
+        if UNCERTAINTY[0] is not None:
+            ax.axhline(UNCERTAINTY[0], color="C3", ls=":", lw=1,
+                       label=f"reference's uncertainty ({100 * UNCERTAINTY[0]:.2g} %; the finest run, "
+                             f"the reference itself, not drawn)")
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel(xlabel)
