@@ -291,8 +291,9 @@ LABEL = {
                 "h/2 run's curve (`footing-reference-h2.csv`, below), both interpolated linearly in z/B; "
                 "the signed differences at each depth, and at z/B = 0.1, are in the status column"),
     "pipeline": ("V/(D cu) at w = 0.5D", "w/D reached", "|V/(D cu) / V_ref − 1| at w = 0.5D, the end "
-                 "of the default's vertical stage (run alone: the lateral stage is left out); V_ref "
-                 "extrapolated from this sweep"),
+                 "of the default's vertical stage (run alone: the lateral stage is left out); V_ref from "
+                 "this sweep's three finest spacings (Richardson, or the finest value when they do not "
+                 "converge monotonically: below); a run stopped early shows no value"),
 }
 
 
@@ -371,6 +372,7 @@ def report(scene, path, out):
     for r in rows:
         err = f"{100 * float(r['error']):.3g} %" if r["error"] else "–"
         value2 = num(r['value2'], '{:.4g}')
+        value = num(r['value'], '{:.6g}') if r["status"] == "ok" or scene != "pipeline" else "–"
         if scene == "footing" and r["value2"] != "":
             value2 = f"{100 * float(r['value2']):+.2f} %"
         status = r["status"] if not r["note"] or r["status"] == "ok" else f"{r['status']} ({r['note']})"
@@ -379,7 +381,7 @@ def report(scene, path, out):
         lines.append(
             f"| {float(r['factor']):g} | {float(r['h_min']):.4g} | {r['steps']} | {r['particles'] or '–'} | "
             f"{r['ranks']} | {r['path']} | {num(r['wall_s'], '{:.1f}')} | {num(r['cpu_s'], '{:.1f}')} | "
-            f"{r['newton_its'] or '–'} | {r['linear_its'] or '–'} | {num(r['value'], '{:.6g}')} | {value2} | {err} | {status} |")
+            f"{r['newton_its'] or '–'} | {r['linear_its'] or '–'} | {value} | {value2} | {err} | {status} |")
     good = [r for r in rows if r["status"] == "ok" and r["error"] and float(r["error"]) <= 0.01
             and r["cpu_s"]]
     lines.append("")
