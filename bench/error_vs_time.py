@@ -202,13 +202,10 @@ def record(path, args):
         w.writerows(rows)
 
 
-# Set by richardson() when the finest value is the reference: its relative uncertainty (plotted).
-UNCERTAINTY = [None]
-
-
 def richardson(rows):
     """Reference from the sweep itself: the direct runs of one step count (the largest that most
-    spacings finished; 1 rank preferred), extrapolated in the spacing. Returns (value, text)."""
+    spacings finished; 1 rank preferred), extrapolated in the spacing. Returns (value, text,
+    uncertainty): the relative uncertainty when the finest value is the reference, else None."""
     best = {}
     ok = [r for r in rows if r["status"] == "ok" and r["path"] == "direct" and r["value"] != ""]
     # One step count for every spacing: the largest that the most spacings finished.
@@ -225,12 +222,12 @@ def richardson(rows):
             best[f] = (rank_pref, float(r["value"]), r)
     fs = sorted(best)  # finest first
     if len(fs) < 2:
-        return None, "fewer than two spacings finished: no Richardson value"
+        return None, "fewer than two spacings finished: no Richardson value", None
     f0, f1 = fs[0], fs[1]
     q0, q1 = best[f0][1], best[f1][1]
     ratio = f1 / f0
     p, how = 1.0, "order 1 assumed (two spacings)"
-    ref = None
+    ref, uncertainty = None, None
     if len(fs) >= 3:
         f2 = fs[2]
         q2 = best[f2][1]
@@ -241,13 +238,13 @@ def richardson(rows):
                 p, how = p_obs, f"observed order {p_obs:.2f} from three spacings (monotone)"
             else:
                 ref = q0
-                UNCERTAINTY[0] = abs(d01 / q0)
+                uncertainty = abs(d01 / q0)
                 how = (f"the observed order {p_obs:.2f} from three spacings is outside 0.5-3: the finest "
                        f"value is the reference, uncertain by the finest-to-middle difference "
                        f"{100 * abs(d01 / q0):.2g} %")
         else:
             ref = q0
-            UNCERTAINTY[0] = abs(d01 / q0)
+            uncertainty = abs(d01 / q0)
             how = (f"the three spacings do not converge monotonically "
                    f"({'increments of opposite sign' if d01 * d12 <= 0 else 'increments not shrinking'}): "
                    f"the finest value is the reference, uncertain by the finest-to-middle difference "
@@ -258,7 +255,7 @@ def richardson(rows):
     used = ", ".join(f"factor {f:g}: {best[f][1]:.5g} ({best[f][2]['steps']} steps, {best[f][2]['ranks']} rank(s))"
                      for f in fs)
     head = "the finest spacing's value" if ref == q0 and len(fs) >= 3 else "Richardson extrapolation in the spacing"
-    return ref, f"{head}, {how}; from {used}"
+    return ref, f"{head}, {how}; from {used}", uncertainty
 
 
 def pareto(points):
@@ -326,11 +323,11 @@ MACHINE_NOTE = {
 
 def report(scene, path, out):
     rows = read_rows(path)
-    ref_text = ""
+    ref_text, uncertainty = "", None
     if scene == "footing":
         ref_text = FOOTING_REF_TEXT
     if scene == "pipeline":
-        ref, ref_text = richardson(rows)
+        ref, ref_text, uncertainty = richardson(rows)
         for r in rows:
             if r["status"] == "ok" and r["value"] != "" and ref is not None:
                 r["error"] = fmt(abs(float(r["value"]) / ref - 1))
@@ -405,10 +402,10 @@ def report(scene, path, out):
         lines.append("**Recommended setting**: none of the runs is within 1 % of the reference.")
     with open(out + ".md", "w") as f:
         f.write("\n".join(lines) + "\n")
-    plot(scene, rows, out + ".png", name)
+    plot(scene, rows, out + ".png", name, uncertainty)
 
 
-def plot(scene, rows, png, name):
+def plot(scene, rows, png, name, uncertainty):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -416,7 +413,7 @@ def plot(scene, rows, png, name):
              ("1", "iterative"): ("^", "C2"), ("2", "iterative"): ("D", "C3")}
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), sharey=True)
     ok = [r for r in rows if r["status"] == "ok" and r["error"] and r["cpu_s"]]
-    if UNCERTAINTY[0] is not None:
+    if uncertainty is not None:
         # The reference run itself (error 0) has no place on a log axis: left out, the reference's
         # uncertainty drawn instead.
         ok = [r for r in ok if float(r["error"]) > 0]
@@ -441,9 +438,9 @@ def plot(scene, rows, png, name):
         if front:
             ax.plot([p[0] for p in front], [p[1] for p in front], "k-", lw=1, zorder=2, label="Pareto front")
         ax.axhline(0.01, color="grey", ls="--", lw=0.8, label="1 %")
-        if UNCERTAINTY[0] is not None:
-            ax.axhline(UNCERTAINTY[0], color="C3", ls=":", lw=1,
-                       label=f"reference's uncertainty ({100 * UNCERTAINTY[0]:.2g} %; the finest run, "
+        if uncertainty is not None:
+            ax.axhline(uncertainty, color="C3", ls=":", lw=1,
+                       label=f"reference's uncertainty ({100 * uncertainty:.2g} %; the finest run, "
                              f"the reference itself, not drawn)")
         ax.set_xscale("log")
         ax.set_yscale("log")

@@ -29,37 +29,34 @@ pub enum LinearSolver<'a> {
     /// and the solves take 35 and more iterations, where CG keeps four. Measured on the
     /// cantilever at h = 1/128 (165 k particles, 2 ranks, one step): peak RSS 1490 MB per rank
     /// with GMRES, 1255 MB with CG, 182 Krylov iterations against 173, the tracked
-    /// displacements equal to 1e-15. With `lean`, see [`LEAN_PTAP`].
-    Amg {
-        rtol: Scalar,
-        symmetric: bool,
-        lean: bool,
-    },
+    /// displacements equal to 1e-15.
+    Amg { rtol: Scalar, symmetric: bool },
     /// Right-preconditioned GMRES with an upper block-triangular Schur-complement field split,
     /// for the mixed P2–P1 saddle point: GAMG on the displacement block (its index set carries
     /// the rigid-body near-null space), and on the Schur complement `pressure_mass`, the
     /// pressure mass matrix scaled by −1/G (spectrally equivalent to the Schur complement of
-    /// a nearly incompressible solid; a Jacobi sweep inverts it well enough). With `lean`, see
-    /// [`LEAN_PTAP`].
+    /// a nearly incompressible solid; a Jacobi sweep inverts it well enough).
     Schur {
         rtol: Scalar,
-        lean: bool,
         displacement: &'a IndexSet,
         pressure: &'a IndexSet,
         pressure_mass: &'a Mat,
     },
 }
 
-/// The Galerkin products of GAMG's set-up (P^T A P) on several ranks, where memory and not
-/// time bounds the run: PETSc's all-at-once algorithm holds no intermediate product. Measured
-/// on the cantilever, 2 ranks, iterative, one step (Newton and CG iterations the same with
-/// either): peak RSS summed over the ranks at h = 1/64 (41 665 particles) 684 → 499 MB, at
-/// 1/128 (165 249) 2 461 → 1 727 MB, about what one rank needs (456 and 1 558 MB); at 1.03 M
+/// Asks GAMG to form its Galerkin products (P^T A P) all at once, holding no intermediate
+/// product: for several ranks where memory and not time bounds the run. Measured on the
+/// cantilever, 2 ranks, iterative, one step (Newton and CG iterations the same with either):
+/// peak RSS summed over the ranks at h = 1/64 (41 665 particles) 684 → 499 MB, at 1/128
+/// (165 249) 2 461 → 1 727 MB, about what one rank needs (456 and 1 558 MB); at 1.03 M
 /// particles 10 255 MB (about 15 GB expected without). The price is time: the products took
 /// 19–22 s instead of 3.0–3.7 s at 1/64, 234 s of the 1.03 M step's 502 s of solve. A
-/// process option: once a run has set it, it keeps it, and the command line wins
-/// (`-matptap_via`). Only MPI matrices know the algorithm, so it is never set on one rank.
-pub const LEAN_PTAP: (&str, &str) = ("-matptap_via", "allatonce");
+/// process option, read when a solver is set up: once a run has set it, it keeps it, and the
+/// command line wins (`-matptap_via`). Only MPI matrices know the algorithm: never call it on
+/// one rank.
+pub fn prefer_lean_galerkin_products() -> Result<(), PetscError> {
+    default_option("-matptap_via", "allatonce")
+}
 
 /// When a direct factorisation is kept for the next Newton iteration. A MUMPS triangular solve
 /// costs about a ninth of a numeric factorisation at h = 1/64 on the cantilever (a seventh at
@@ -157,12 +154,6 @@ impl LinearSolver<'_> {
 
     /// Collective. Configures `ksp` (borrowed from a SNES).
     pub(crate) fn configure(&self, ksp: ffi::KSP) -> Result<(), PetscError> {
-        if matches!(
-            self,
-            LinearSolver::Amg { lean: true, .. } | LinearSolver::Schur { lean: true, .. }
-        ) {
-            default_option(LEAN_PTAP.0, LEAN_PTAP.1)?;
-        }
         let mut pc: ffi::PC = std::ptr::null_mut();
         // SAFETY: `ksp` is the live KSP of a SNES we own; the PC is borrowed from it. Index
         // sets and matrices handed to the PC are referenced by PETSc, not taken over.
@@ -203,9 +194,7 @@ impl LinearSolver<'_> {
                         "PCFactorSetMatSolverType",
                     )?;
                 }
-                LinearSolver::Amg {
-                    rtol, symmetric, ..
-                } => {
+                LinearSolver::Amg { rtol, symmetric } => {
                     if *symmetric {
                         conjugate_gradients(ksp, *rtol)?;
                     } else {
@@ -224,7 +213,6 @@ impl LinearSolver<'_> {
                     displacement,
                     pressure,
                     pressure_mass,
-                    ..
                 } => {
                     krylov(ksp, *rtol)?;
                     set_pc_type(pc, "fieldsplit")?;

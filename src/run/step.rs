@@ -297,11 +297,12 @@ impl Simulation {
             None
         };
         // Past the size where `auto` turns iterative to save memory, memory keeps the lead.
-        let lean = world.size() > 1 && dofs.n_global_dofs > ITERATIVE_ABOVE_DOFS;
+        if iterative && world.size() > 1 && dofs.n_global_dofs > ITERATIVE_ABOVE_DOFS {
+            crate::petsc::linear::prefer_lean_galerkin_products()?;
+        }
         let linear = match &split {
             Some(s) => LinearSolver::Schur {
                 rtol: SCHUR_RTOL,
-                lean,
                 displacement: &s.displacement_field,
                 pressure: &s.pressure_field,
                 pressure_mass: &s.pressure_mass,
@@ -309,7 +310,6 @@ impl Simulation {
             None if iterative => LinearSolver::Amg {
                 rtol: AMG_RTOL,
                 symmetric: self.symmetric_tangent(),
-                lean,
             },
             None => LinearSolver::Direct {
                 reuse: crate::petsc::FactorReuse::from_options(solver.reuse_factorisation)?,
