@@ -845,39 +845,51 @@ fn fill_p_multigrid(
     let ints = |v: &[usize]| -> Result<Vec<crate::petsc::Int>, String> {
         v.iter().map(|&g| to_int(g)).collect()
     };
-    let p = m.interpolation.as_ref();
+    let (p, a) = (m.interpolation.as_ref(), m.coarse.as_ref());
     p.zero_entries().map_err(petsc)?;
-    m.space.interpolation(dofs, setup.constraints, |r, c, w| {
-        p.add_values(&[to_int(r)?], &ints(c)?, w).map_err(petsc)
-    })?;
-    p.assemble().map_err(petsc)?;
-    let a = m.coarse.as_ref();
     a.zero_entries().map_err(petsc)?;
-    let stiffness = m.space.stiffness(
-        mesh,
-        dofs,
-        (setup.constraints, setup.states_n, setup.material),
-        |rows, cols, vals| {
-            a.add_values(&ints(rows)?, &ints(cols)?, vals)
-                .map_err(petsc)
-        },
-    );
-    // Every rank learns of a failure, so that none is left in the reductions below.
-    let failed = sum_f64(world, &[if stiffness.is_err() { 1.0 } else { 0.0 }])[0];
-    let (sum, count) = match stiffness {
+    // Rank-local insertions; a failure on any rank is agreed on before the collective
+    // assemblies, so that no rank waits in one alone.
+    let local = m
+        .space
+        .interpolation(dofs, setup.constraints, |r, c, w| {
+            p.add_values(&[to_int(r)?], &ints(c)?, w).map_err(petsc)
+        })
+        .and_then(|()| {
+            m.space.stiffness(
+                mesh,
+                dofs,
+                (setup.constraints, setup.states_n, setup.material),
+                |rows, cols, vals| {
+                    a.add_values(&ints(rows)?, &ints(cols)?, vals)
+                        .map_err(petsc)
+                },
+            )
+        });
+    let failed = sum_f64(world, &[if local.is_err() { 1.0 } else { 0.0 }])[0];
+    let (sum, count) = match local {
         Ok(s) if failed == 0.0 => s,
-        Ok(_) => return Err("coarse stiffness failed on another rank".into()),
+        Ok(_) => return Err("the p-multigrid's coarse level failed on another rank".into()),
         Err(e) => return Err(e),
     };
+    p.assemble().map_err(petsc)?;
     let totals = sum_f64(world, &[sum, count as f64]);
     let diagonal = if totals[1] > 0.0 {
         totals[0] / totals[1]
     } else {
         1.0
     };
-    for r in m.space.fixed_rows(dofs, setup.constraints) {
-        a.add_values(&[to_int(r)?], &[to_int(r)?], &[diagonal])
-            .map_err(petsc)?;
+    let fixed = m
+        .space
+        .fixed_rows(dofs, setup.constraints)
+        .into_iter()
+        .try_for_each(|r| {
+            a.add_values(&[to_int(r)?], &[to_int(r)?], &[diagonal])
+                .map_err(petsc)
+        });
+    if sum_f64(world, &[if fixed.is_err() { 1.0 } else { 0.0 }])[0] > 0.0 {
+        fixed?;
+        return Err("the p-multigrid's coarse level failed on another rank".into());
     }
     a.assemble().map_err(petsc)?;
     let modes = orthonormal_rigid_body_modes(world, &m.space.coordinates(mesh, dofs));
