@@ -1,5 +1,6 @@
-//! The iterative linear path (GMRES with GAMG and the rigid-body near-null space for P2, a
-//! Schur-complement field split for P2–P1) against the direct one: same Newton histories, a
+//! The iterative linear path (for P2 a two-level p-multigrid whose P1 coarse level has the
+//! rigid-body near-null space, or GAMG on P2 with `-pfem_pmg false`; a Schur-complement field
+//! split for P2–P1) against the direct one: same Newton histories, a
 //! linear iteration count that does not grow with refinement, convergence for a nearly
 //! incompressible solid, and the rigid-body modes in the kernel of the stiffness.
 
@@ -51,14 +52,15 @@ fn iterations(stdout: &str) -> (usize, usize) {
 }
 
 /// Writes `case` (scene `scene` with `sets`), runs it with the direct and the iterative
-/// solver on `ranks` ranks for `steps` steps, and returns the histories' largest relative
-/// difference and the iterative run's (Newton, linear) iterations.
+/// solver (given the PETSc options `petsc`) on `ranks` ranks for `steps` steps, and returns the
+/// histories' largest relative difference and the iterative run's (Newton, linear) iterations.
 fn direct_against_iterative(
     dir: &Path,
     scene: &str,
     sets: &[&str],
     ranks: usize,
     steps: u32,
+    petsc: &[&str],
 ) -> (f64, (usize, usize)) {
     let until = steps.to_string();
     let mut outs = Vec::new();
@@ -71,7 +73,12 @@ fn direct_against_iterative(
         }
         ok(dir, 1, &args);
         let out = format!("{linear}{ranks}");
-        let stdout = ok(dir, ranks, &[&case, "--out", &out, "--until-step", &until]);
+        let mut run = vec![case.as_str(), "--out", &out, "--until-step", &until];
+        if linear == "iterative" && !petsc.is_empty() {
+            run.push("--");
+            run.extend(petsc);
+        }
+        let stdout = ok(dir, ranks, &run);
         outs.push((out, stdout));
     }
     let diff = max_relative_difference(
@@ -84,21 +91,50 @@ fn direct_against_iterative(
 #[test]
 fn iterative_cantilever_matches_the_direct_history_on_1_and_2_ranks() {
     let dir = workdir("iterative-cantilever");
-    for ranks in [1, 2] {
-        let (diff, (newton, linear)) = direct_against_iterative(
-            &dir,
-            "cantilever",
-            &["mesh.h=0.25", "steps.count=10"],
-            ranks,
-            3,
-        );
-        println!("cantilever, {ranks} ranks: max relative difference {diff:.2e}, {newton} Newton and {linear} linear iterations");
-        assert!(diff < 1e-6, "{ranks} ranks: {diff:e}");
-        assert!(
-            linear > newton,
-            "the iterative path ran: {linear} linear iterations"
-        );
+    for petsc in [&[][..], &["-pfem_pmg", "false"][..]] {
+        for ranks in [1, 2] {
+            let (diff, (newton, linear)) = direct_against_iterative(
+                &dir,
+                "cantilever",
+                &["mesh.h=0.25", "steps.count=10"],
+                ranks,
+                3,
+                petsc,
+            );
+            println!("cantilever {petsc:?}, {ranks} ranks: max relative difference {diff:.2e}, {newton} Newton and {linear} linear iterations");
+            assert!(diff < 1e-6, "{petsc:?}, {ranks} ranks: {diff:e}");
+            assert!(
+                linear > newton,
+                "the iterative path ran: {linear} linear iterations"
+            );
+        }
     }
+}
+
+#[test]
+fn the_p2_iterative_path_is_a_p_multigrid_unless_asked_for_gamg() {
+    let dir = workdir("iterative-pmg");
+    common::small_cantilever(&dir, 10, &["solver.linear=\"iterative\""]);
+    let view = |extra: &[&str]| {
+        let mut args = vec!["c.h5", "--until-step", "1", "--", "-ksp_view"];
+        args.extend(extra);
+        ok(&dir, 2, &args)
+    };
+    // The outer PC is PCMG with two levels, a Chebyshev–Jacobi smoother on P2 and GAMG on the
+    // coarse P1 operator; asked for GAMG, there is no PCMG level at all.
+    let pmg = view(&[]);
+    for want in [
+        "type: mg",
+        "levels=2",
+        "type: chebyshev",
+        "type: jacobi",
+        "type: gamg",
+    ] {
+        assert!(pmg.contains(want), "no '{want}' in\n{pmg}");
+    }
+    let gamg = view(&["-pfem_pmg", "false"]);
+    assert!(gamg.contains("type: gamg"), "{gamg}");
+    assert!(!gamg.contains("levels=2,"), "{gamg}");
 }
 
 #[test]
@@ -115,6 +151,7 @@ fn iterative_footing_shallow_matches_the_direct_history_on_1_and_2_ranks() {
             ],
             ranks,
             3,
+            &[],
         );
         println!("footing-shallow, {ranks} ranks: max relative difference {diff:.2e}, {newton} Newton and {linear} linear iterations");
         assert!(diff < 1e-6, "{ranks} ranks: {diff:e}");
@@ -176,6 +213,7 @@ fn nearly_incompressible_elastic_block_converges_with_the_field_split() {
         ],
         1,
         3,
+        &[],
     );
     println!("block, nu = 0.4999: max relative difference {diff:.2e}, {newton} Newton and {linear} linear iterations");
     assert!(diff < 1e-6, "{diff:e}");

@@ -26,6 +26,19 @@ impl Mat {
         d_nnz: &[usize],
         o_nnz: &[usize],
     ) -> Result<Mat, PetscError> {
+        Mat::aij_rect(comm, [n_local, n_local], block, d_nnz, o_nnz)
+    }
+
+    /// Collective. As [`Mat::aij`], with `local[0]` owned rows and `local[1]` owned columns (an
+    /// interpolation between two spaces); rows and columns share the block size.
+    pub fn aij_rect(
+        comm: &SimpleCommunicator,
+        local: [usize; 2],
+        block: usize,
+        d_nnz: &[usize],
+        o_nnz: &[usize],
+    ) -> Result<Mat, PetscError> {
+        let n_local = local[0];
         assert_eq!(d_nnz.len(), n_local, "one diagonal count per owned row");
         assert_eq!(o_nnz.len(), n_local, "one off-diagonal count per owned row");
         let ints = |v: &[usize]| {
@@ -36,6 +49,7 @@ impl Mat {
         let (d_nnz, o_nnz) = (ints(d_nnz)?, ints(o_nnz)?);
         let mut raw: ffi::Mat = std::ptr::null_mut();
         let n = to_int(n_local, "matrix rows")?;
+        let m = to_int(local[1], "matrix columns")?;
         let det = ffi::PETSC_DETERMINE as Int;
         // SAFETY: out-pointer to a fresh handle, owned by `mat` from the next line on; the nnz
         // arrays have n_local entries and are copied by PETSc. The block size must be set
@@ -43,7 +57,7 @@ impl Mat {
         unsafe {
             check(ffi::MatCreate(comm.as_raw(), &mut raw), "MatCreate")?;
             let mat = Mat { raw };
-            check(ffi::MatSetSizes(raw, n, n, det, det), "MatSetSizes")?;
+            check(ffi::MatSetSizes(raw, n, m, det, det), "MatSetSizes")?;
             let aij = super::init::cstring("aij")?;
             check(ffi::MatSetType(raw, aij.as_ptr()), "MatSetType")?;
             check(
@@ -57,6 +71,70 @@ impl Mat {
             check(
                 ffi::MatMPIAIJSetPreallocation(raw, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()),
                 "MatMPIAIJSetPreallocation",
+            )?;
+            for (option, name) in [
+                (
+                    ffi::MatOption_MAT_NO_OFF_PROC_ENTRIES,
+                    "MatSetOption(MAT_NO_OFF_PROC_ENTRIES)",
+                ),
+                (
+                    ffi::MatOption_MAT_NEW_NONZERO_ALLOCATION_ERR,
+                    "MatSetOption(MAT_NEW_NONZERO_ALLOCATION_ERR)",
+                ),
+            ] {
+                check(
+                    ffi::MatSetOption(raw, option, ffi::PetscBool_PETSC_TRUE),
+                    name,
+                )?;
+            }
+            Ok(mat)
+        }
+    }
+
+    /// Collective. MPIBAIJ (SeqBAIJ on one rank) with `n_local` owned rows and columns in
+    /// blocks of `block`, from the same per-row counts as [`Mat::aij`] (rows of a block must
+    /// share their counts). A block's values are stored together under one column index: for
+    /// 2 × 2 blocks 9 bytes a nonzero instead of 12, and a faster product. For operators that
+    /// are only multiplied and read on the diagonal (PCMG's smoothed fine level); GAMG and the
+    /// factorisations want AIJ.
+    pub fn baij(
+        comm: &SimpleCommunicator,
+        n_local: usize,
+        block: usize,
+        d_nnz: &[usize],
+        o_nnz: &[usize],
+    ) -> Result<Mat, PetscError> {
+        assert_eq!(d_nnz.len(), n_local, "one diagonal count per owned row");
+        assert_eq!(o_nnz.len(), n_local, "one off-diagonal count per owned row");
+        assert_eq!(n_local % block, 0, "whole blocks of rows");
+        let blocks = |v: &[usize]| {
+            v.chunks(block)
+                .map(|c| {
+                    debug_assert!(c.iter().all(|&k| k == c[0]), "a block's rows share counts");
+                    to_int(c[0].div_ceil(block), "blocks per row")
+                })
+                .collect::<Result<Vec<Int>, _>>()
+        };
+        let (d_nnz, o_nnz) = (blocks(d_nnz)?, blocks(o_nnz)?);
+        let mut raw: ffi::Mat = std::ptr::null_mut();
+        let n = to_int(n_local, "matrix rows")?;
+        let bs = to_int(block, "block size")?;
+        let det = ffi::PETSC_DETERMINE as Int;
+        // SAFETY: out-pointer to a fresh handle, owned by `mat` from the next line on; the
+        // block counts have n_local / block entries and are copied by PETSc.
+        unsafe {
+            check(ffi::MatCreate(comm.as_raw(), &mut raw), "MatCreate")?;
+            let mat = Mat { raw };
+            check(ffi::MatSetSizes(raw, n, n, det, det), "MatSetSizes")?;
+            let baij = super::init::cstring("baij")?;
+            check(ffi::MatSetType(raw, baij.as_ptr()), "MatSetType")?;
+            check(
+                ffi::MatSeqBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr()),
+                "MatSeqBAIJSetPreallocation",
+            )?;
+            check(
+                ffi::MatMPIBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()),
+                "MatMPIBAIJSetPreallocation",
             )?;
             for (option, name) in [
                 (

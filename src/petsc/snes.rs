@@ -229,6 +229,16 @@ impl Snes {
     }
 }
 
+impl Snes {
+    /// Collective. Frees what the last solve set up (work vectors, the preconditioner's
+    /// hierarchy and the Krylov method's vectors), keeping the configuration; the next solve
+    /// sets up again.
+    pub fn reset(&mut self) -> Result<(), PetscError> {
+        // SAFETY: live SNES we own; the matrices and vectors it referenced stay owned by us.
+        check(unsafe { ffi::SNESReset(self.raw) }, "SNESReset")
+    }
+}
+
 impl Drop for Snes {
     fn drop(&mut self) {
         // SAFETY: we own the SNES.

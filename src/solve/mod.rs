@@ -4,6 +4,7 @@
 pub mod constraints;
 pub mod dofs;
 pub mod nullspace;
+pub mod pmg;
 pub mod problem;
 pub mod split;
 

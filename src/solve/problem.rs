@@ -73,10 +73,11 @@ pub struct StepProblem<'a> {
     dofs: &'a DofMap,
     setup: StepSetup<'a>,
     scatter: Scatter,
-    /// Start-of-step nodes of every triangle (straight sided).
-    geometry: Vec<[[f64; 2]; 6]>,
-    /// Local-vector index of every element dof, per triangle.
-    element_dofs: Vec<Vec<usize>>,
+    /// Local-vector index of every element dof, `dofs_per_element` per triangle, flat (u32:
+    /// a rank's local vector stays far below 4 G entries, and at a million particles per rank
+    /// per-triangle vectors of usize cost 170 bytes a triangle more).
+    element_dofs: Vec<u32>,
+    dofs_per_element: usize,
     /// The diagonal of a constrained row: the mean diagonal of the free displacement rows, so
     /// that the constrained rows neither stand out of an AMG hierarchy nor spoil the
     /// conditioning (fixed on the first evaluation of the increment).
@@ -119,34 +120,34 @@ impl<'a> StepProblem<'a> {
         template: &PVec,
     ) -> Result<StepProblem<'a>, PetscError> {
         let scatter = Scatter::new(template, &dofs.local_to_global())?;
-        let geometry = mesh
-            .tris
-            .iter()
-            .map(|t| straight_sided(&t.map(|v| mesh.points[v as usize])))
-            .collect();
         let mixed = matches!(setup.kernel, Kernel::P2P1 { .. });
-        let element_dofs = dofs
-            .tri_nodes
-            .iter()
-            .map(|nodes| {
-                let mut d: Vec<usize> = nodes
-                    .iter()
-                    .flat_map(|&n| [dofs.node_local[n as usize], dofs.node_local[n as usize] + 1])
-                    .collect();
-                if mixed {
-                    d.extend(nodes[..3].iter().map(|&n| dofs.node_local[n as usize] + 2));
-                }
-                d
+        let dofs_per_element = if mixed { 15 } else { 12 };
+        let local_index = |i: usize| {
+            u32::try_from(i).map_err(|_| PetscError {
+                code: -1,
+                message: format!("local dof {i} does not fit 32 bits"),
             })
-            .collect::<Vec<Vec<usize>>>();
+        };
+        let mut element_dofs = Vec::with_capacity(dofs_per_element * dofs.tri_nodes.len());
+        for nodes in &dofs.tri_nodes {
+            for &n in nodes {
+                let first = dofs.node_local[n as usize];
+                element_dofs.extend([local_index(first)?, local_index(first + 1)?]);
+            }
+            if mixed {
+                for &n in &nodes[..3] {
+                    element_dofs.push(local_index(dofs.node_local[n as usize] + 2)?);
+                }
+            }
+        }
         let l2g = dofs.local_to_global();
-        let mut sorted_cols = Vec::new();
-        let mut sorted_dofs = Vec::new();
-        for d in &element_dofs {
+        let mut sorted_cols = Vec::with_capacity(element_dofs.len());
+        let mut sorted_dofs = Vec::with_capacity(element_dofs.len());
+        for d in element_dofs.chunks(dofs_per_element) {
             let mut order: Vec<u8> = (0..d.len() as u8).collect();
-            order.sort_by_key(|&k| l2g[d[k as usize]]);
+            order.sort_by_key(|&k| l2g[d[k as usize] as usize]);
             for &k in &order {
-                sorted_cols.push(to_int(l2g[d[k as usize]], "dof")?);
+                sorted_cols.push(to_int(l2g[d[k as usize] as usize], "dof")?);
             }
             sorted_dofs.extend_from_slice(&order);
         }
@@ -156,8 +157,8 @@ impl<'a> StepProblem<'a> {
             dofs,
             setup,
             scatter,
-            geometry,
             element_dofs,
+            dofs_per_element,
             diagonal: Cell::new(None),
             schur: None,
             cache: RefCell::new(None),
@@ -165,6 +166,15 @@ impl<'a> StepProblem<'a> {
             sorted_cols,
             sorted_dofs,
         })
+    }
+
+    fn n_triangles(&self) -> usize {
+        self.dofs.tri_nodes.len()
+    }
+
+    /// Start-of-step nodes of triangle `t` (straight sided).
+    fn geometry(&self, t: usize) -> [[f64; 2]; 6] {
+        straight_sided(&self.mesh.tris[t].map(|v| self.mesh.points[v as usize]))
     }
 
     /// Assembles `schur` with every Jacobian (mixed kernels only).
@@ -252,7 +262,7 @@ impl<'a> StepProblem<'a> {
             return Ok(elems);
         }
         let tangent = self.keep_elements;
-        (0..self.element_dofs.len())
+        (0..self.n_triangles())
             .map(|t| self.evaluate_element(t, local, tangent))
             .collect()
     }
@@ -277,44 +287,41 @@ impl<'a> StepProblem<'a> {
         tangent: bool,
     ) -> Result<ElementResult, String> {
         let s = &self.setup;
-        let dofs = &self.element_dofs[t];
-        let du: [[f64; 2]; 6] =
-            std::array::from_fn(|k| [local[dofs[2 * k]], local[dofs[2 * k + 1]]]);
+        let n = self.dofs_per_element;
+        let dofs = &self.element_dofs[t * n..(t + 1) * n];
+        let at = |k: usize| local[dofs[k] as usize];
+        let du: [[f64; 2]; 6] = std::array::from_fn(|k| [at(2 * k), at(2 * k + 1)]);
+        let geometry = self.geometry(t);
         let flat = |k: &[f64]| if tangent { k.to_vec() } else { Vec::new() };
-        let result = match s.kernel {
-            Kernel::P2 => p2_element(
-                &self.geometry[t],
-                &du,
-                &s.states_n[t],
-                s.material,
-                s.body_force,
-            )
-            .map(|e| ElementResult {
-                residual: e.residual.to_vec(),
-                tangent: flat(e.tangent.as_flattened()),
-                states: e.states,
-            }),
-            Kernel::P2P1 { bulk, scale } => {
-                let p: [f64; 3] = std::array::from_fn(|k| scale * local[dofs[12 + k]]);
-                p2p1_element(
-                    &self.geometry[t],
-                    &du,
-                    &p,
-                    &s.states_n[t],
-                    s.material,
-                    bulk,
-                    s.body_force,
-                )
-                .map(|e| {
-                    let e = e.with_pressure_scale(scale);
-                    ElementResult {
+        let result =
+            match s.kernel {
+                Kernel::P2 => p2_element(&geometry, &du, &s.states_n[t], s.material, s.body_force)
+                    .map(|e| ElementResult {
                         residual: e.residual.to_vec(),
                         tangent: flat(e.tangent.as_flattened()),
                         states: e.states,
-                    }
-                })
-            }
-        };
+                    }),
+                Kernel::P2P1 { bulk, scale } => {
+                    let p: [f64; 3] = std::array::from_fn(|k| scale * at(12 + k));
+                    p2p1_element(
+                        &geometry,
+                        &du,
+                        &p,
+                        &s.states_n[t],
+                        s.material,
+                        bulk,
+                        s.body_force,
+                    )
+                    .map(|e| {
+                        let e = e.with_pressure_scale(scale);
+                        ElementResult {
+                            residual: e.residual.to_vec(),
+                            tangent: flat(e.tangent.as_flattened()),
+                            states: e.states,
+                        }
+                    })
+                }
+            };
         result.map_err(|e| format!("triangle {:?}: {e}", self.mesh.tri_key(t)))
     }
 
@@ -341,7 +348,7 @@ impl<'a> StepProblem<'a> {
         let mut keep = Vec::new();
         let cached = self.cached(&local);
         let mut failed = None;
-        for t in 0..self.element_dofs.len() {
+        for t in 0..self.n_triangles() {
             let mut fresh = None;
             let e: &ElementResult = match &cached {
                 Some(elems) => &elems[t],
@@ -780,7 +787,7 @@ impl StepProblem<'_> {
                 continue;
             }
             let du: [[f64; 2]; 6] = std::array::from_fn(|k| self.node_u(local, nodes[k] as usize));
-            let x = &self.geometry[t];
+            let x = &self.geometry(t);
             let g = super::split::effective_shear_modulus(
                 x,
                 &du,
