@@ -86,27 +86,8 @@ pub struct FactorReuse {
 impl FactorReuse {
     /// The defaults, or none when the PETSc option `-pfem_lu_reuse false` (or `0`) is given.
     pub fn from_options(default_on: bool) -> Result<Option<FactorReuse>, PetscError> {
-        let name = cstring("-pfem_lu_reuse")?;
-        let mut on = if default_on {
-            ffi::PetscBool_PETSC_TRUE
-        } else {
-            ffi::PetscBool_PETSC_FALSE
-        };
-        let mut given = ffi::PetscBool_PETSC_FALSE;
-        // SAFETY: nul-terminated name; the global options database is live.
-        unsafe {
-            check(
-                ffi::PetscOptionsGetBool(
-                    std::ptr::null_mut(),
-                    std::ptr::null(),
-                    name.as_ptr(),
-                    &mut on,
-                    &mut given,
-                ),
-                "PetscOptionsGetBool(-pfem_lu_reuse)",
-            )?;
-        }
-        if on != ffi::PetscBool_PETSC_TRUE {
+        let on = bool_option("-pfem_lu_reuse", default_on)?;
+        if !on {
             return Ok(None);
         }
         Ok(Some(FactorReuse {
@@ -141,8 +122,17 @@ fn real_option(name: &str, default: f64) -> Result<f64, PetscError> {
 /// Whether the iterative P2 path uses the two-level p-multigrid ([`LinearSolver::PMultigrid`]):
 /// yes unless the PETSc option `-pfem_pmg false` (or `0`) asks for GAMG on the P2 system.
 pub fn p_multigrid_from_options() -> Result<bool, PetscError> {
-    let name = cstring("-pfem_pmg")?;
-    let mut on = ffi::PetscBool_PETSC_TRUE;
+    bool_option("-pfem_pmg", true)
+}
+
+/// The PETSc option `name` as a boolean (`true`/`false`, `1`/`0`, ...), or `default`.
+fn bool_option(name: &str, default: bool) -> Result<bool, PetscError> {
+    let n = cstring(name)?;
+    let mut on = if default {
+        ffi::PetscBool_PETSC_TRUE
+    } else {
+        ffi::PetscBool_PETSC_FALSE
+    };
     let mut given = ffi::PetscBool_PETSC_FALSE;
     // SAFETY: nul-terminated name; the global options database is live.
     unsafe {
@@ -150,11 +140,11 @@ pub fn p_multigrid_from_options() -> Result<bool, PetscError> {
             ffi::PetscOptionsGetBool(
                 std::ptr::null_mut(),
                 std::ptr::null(),
-                name.as_ptr(),
+                n.as_ptr(),
                 &mut on,
                 &mut given,
             ),
-            "PetscOptionsGetBool(-pfem_pmg)",
+            "PetscOptionsGetBool",
         )?;
     }
     Ok(on == ffi::PetscBool_PETSC_TRUE)

@@ -47,19 +47,11 @@ impl Mat {
                 .collect::<Result<Vec<Int>, _>>()
         };
         let (d_nnz, o_nnz) = (ints(d_nnz)?, ints(o_nnz)?);
-        let mut raw: ffi::Mat = std::ptr::null_mut();
-        let n = to_int(n_local, "matrix rows")?;
-        let m = to_int(local[1], "matrix columns")?;
-        let det = ffi::PETSC_DETERMINE as Int;
-        // SAFETY: out-pointer to a fresh handle, owned by `mat` from the next line on; the nnz
-        // arrays have n_local entries and are copied by PETSc. The block size must be set
-        // before preallocation, which fixes it.
+        let mat = Mat::create(comm, local, "aij")?;
+        let raw = mat.raw;
+        // SAFETY: live handle; the nnz arrays have n_local entries and are copied by PETSc.
+        // The block size must be set before preallocation, which fixes it.
         unsafe {
-            check(ffi::MatCreate(comm.as_raw(), &mut raw), "MatCreate")?;
-            let mat = Mat { raw };
-            check(ffi::MatSetSizes(raw, n, m, det, det), "MatSetSizes")?;
-            let aij = super::init::cstring("aij")?;
-            check(ffi::MatSetType(raw, aij.as_ptr()), "MatSetType")?;
             check(
                 ffi::MatSetBlockSize(raw, to_int(block, "block size")?),
                 "MatSetBlockSize",
@@ -72,21 +64,7 @@ impl Mat {
                 ffi::MatMPIAIJSetPreallocation(raw, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()),
                 "MatMPIAIJSetPreallocation",
             )?;
-            for (option, name) in [
-                (
-                    ffi::MatOption_MAT_NO_OFF_PROC_ENTRIES,
-                    "MatSetOption(MAT_NO_OFF_PROC_ENTRIES)",
-                ),
-                (
-                    ffi::MatOption_MAT_NEW_NONZERO_ALLOCATION_ERR,
-                    "MatSetOption(MAT_NEW_NONZERO_ALLOCATION_ERR)",
-                ),
-            ] {
-                check(
-                    ffi::MatSetOption(raw, option, ffi::PetscBool_PETSC_TRUE),
-                    name,
-                )?;
-            }
+            strict_assembly(raw)?;
             Ok(mat)
         }
     }
@@ -116,18 +94,12 @@ impl Mat {
                 .collect::<Result<Vec<Int>, _>>()
         };
         let (d_nnz, o_nnz) = (blocks(d_nnz)?, blocks(o_nnz)?);
-        let mut raw: ffi::Mat = std::ptr::null_mut();
-        let n = to_int(n_local, "matrix rows")?;
         let bs = to_int(block, "block size")?;
-        let det = ffi::PETSC_DETERMINE as Int;
-        // SAFETY: out-pointer to a fresh handle, owned by `mat` from the next line on; the
-        // block counts have n_local / block entries and are copied by PETSc.
+        let mat = Mat::create(comm, [n_local, n_local], "baij")?;
+        let raw = mat.raw;
+        // SAFETY: live handle; the block counts have n_local / block entries and are copied
+        // by PETSc.
         unsafe {
-            check(ffi::MatCreate(comm.as_raw(), &mut raw), "MatCreate")?;
-            let mat = Mat { raw };
-            check(ffi::MatSetSizes(raw, n, n, det, det), "MatSetSizes")?;
-            let baij = super::init::cstring("baij")?;
-            check(ffi::MatSetType(raw, baij.as_ptr()), "MatSetType")?;
             check(
                 ffi::MatSeqBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr()),
                 "MatSeqBAIJSetPreallocation",
@@ -136,21 +108,25 @@ impl Mat {
                 ffi::MatMPIBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()),
                 "MatMPIBAIJSetPreallocation",
             )?;
-            for (option, name) in [
-                (
-                    ffi::MatOption_MAT_NO_OFF_PROC_ENTRIES,
-                    "MatSetOption(MAT_NO_OFF_PROC_ENTRIES)",
-                ),
-                (
-                    ffi::MatOption_MAT_NEW_NONZERO_ALLOCATION_ERR,
-                    "MatSetOption(MAT_NEW_NONZERO_ALLOCATION_ERR)",
-                ),
-            ] {
-                check(
-                    ffi::MatSetOption(raw, option, ffi::PetscBool_PETSC_TRUE),
-                    name,
-                )?;
-            }
+            strict_assembly(raw)?;
+            Ok(mat)
+        }
+    }
+
+    /// Collective. An empty matrix of type `kind` with `local[0]` owned rows and `local[1]`
+    /// owned columns.
+    fn create(comm: &SimpleCommunicator, local: [usize; 2], kind: &str) -> Result<Mat, PetscError> {
+        let n = to_int(local[0], "matrix rows")?;
+        let m = to_int(local[1], "matrix columns")?;
+        let det = ffi::PETSC_DETERMINE as Int;
+        let kind = super::init::cstring(kind)?;
+        let mut raw: ffi::Mat = std::ptr::null_mut();
+        // SAFETY: out-pointer to a fresh handle, owned by `mat` from the next line on.
+        unsafe {
+            check(ffi::MatCreate(comm.as_raw(), &mut raw), "MatCreate")?;
+            let mat = Mat { raw };
+            check(ffi::MatSetSizes(raw, n, m, det, det), "MatSetSizes")?;
+            check(ffi::MatSetType(raw, kind.as_ptr()), "MatSetType")?;
             Ok(mat)
         }
     }
@@ -205,6 +181,30 @@ impl Drop for Mat {
             ffi::MatDestroy(&mut self.raw);
         }
     }
+}
+
+/// Only owned rows may be set, and a value outside the preallocated pattern is an error.
+///
+/// # Safety
+/// `raw` must be a live matrix.
+unsafe fn strict_assembly(raw: ffi::Mat) -> Result<(), PetscError> {
+    for (option, name) in [
+        (
+            ffi::MatOption_MAT_NO_OFF_PROC_ENTRIES,
+            "MatSetOption(MAT_NO_OFF_PROC_ENTRIES)",
+        ),
+        (
+            ffi::MatOption_MAT_NEW_NONZERO_ALLOCATION_ERR,
+            "MatSetOption(MAT_NEW_NONZERO_ALLOCATION_ERR)",
+        ),
+    ] {
+        // SAFETY: live matrix (the caller's promise).
+        check(
+            unsafe { ffi::MatSetOption(raw, option, ffi::PetscBool_PETSC_TRUE) },
+            name,
+        )?;
+    }
+    Ok(())
 }
 
 /// A matrix borrowed for `'a`: from a `Mat` we own, or lent by PETSc for the length of a

@@ -219,6 +219,32 @@ impl DofMap {
             .collect()
     }
 
+    /// Per owned vertex node, in node order: how many vertex nodes (itself included) share a
+    /// triangle with it, owned by this rank and by others: the pattern of a P1 matrix on the
+    /// vertices.
+    pub fn vertex_neighbour_counts(&self) -> Vec<(usize, usize)> {
+        let n_vertex = self.n_nodes() - self.edges.len();
+        let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n_vertex];
+        for nodes in &self.tri_nodes {
+            for &a in &nodes[..3] {
+                if self.node_owned[a as usize] {
+                    neighbours[a as usize].extend_from_slice(&nodes[..3]);
+                }
+            }
+        }
+        let mut counts = Vec::new();
+        for (a, nb) in neighbours.iter_mut().enumerate() {
+            if !self.node_owned[a] {
+                continue;
+            }
+            nb.sort_unstable();
+            nb.dedup();
+            let owned = nb.iter().filter(|&&b| self.node_owned[b as usize]).count();
+            counts.push((owned, nb.len() - owned));
+        }
+        counts
+    }
+
     /// Exact nonzero counts per owned row in the diagonal and off-diagonal blocks, from the mesh
     /// graph: every triangle around an owned node is on this rank.
     pub fn preallocation(&self) -> (Vec<usize>, Vec<usize>) {

@@ -58,25 +58,11 @@ impl CoarseSpace {
                 interpolation_o_nnz.push(ends.len() - inside);
             }
         }
-        let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n_vertex];
-        for nodes in &dofs.tri_nodes {
-            for &a in &nodes[..3] {
-                if dofs.node_owned[a as usize] {
-                    neighbours[a as usize].extend_from_slice(&nodes[..3]);
-                }
-            }
-        }
         let (mut stiffness_d_nnz, mut stiffness_o_nnz) = (Vec::new(), Vec::new());
-        for (a, nb) in neighbours.iter_mut().enumerate() {
-            if !dofs.node_owned[a] {
-                continue;
-            }
-            nb.sort_unstable();
-            nb.dedup();
-            let owned = nb.iter().filter(|&&b| dofs.node_owned[b as usize]).count();
+        for (owned, other) in dofs.vertex_neighbour_counts() {
             for _ in 0..2 {
                 stiffness_d_nnz.push(2 * owned);
-                stiffness_o_nnz.push(2 * (nb.len() - owned));
+                stiffness_o_nnz.push(2 * other);
             }
         }
         Ok(CoarseSpace {

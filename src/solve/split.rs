@@ -65,26 +65,7 @@ impl FieldLayout {
                 first_pressure[r] + (g - first_dof[r]) / 3
             })
             .collect();
-        let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n_vertex];
-        for nodes in &dofs.tri_nodes {
-            for &a in &nodes[..3] {
-                if dofs.node_owned[a as usize] {
-                    neighbours[a as usize].extend_from_slice(&nodes[..3]);
-                }
-            }
-        }
-        let mut mass_d_nnz = Vec::with_capacity(pressure.len());
-        let mut mass_o_nnz = Vec::with_capacity(pressure.len());
-        for (a, nb) in neighbours.iter_mut().enumerate() {
-            if !dofs.node_owned[a] {
-                continue;
-            }
-            nb.sort_unstable();
-            nb.dedup();
-            let owned = nb.iter().filter(|&&b| dofs.node_owned[b as usize]).count();
-            mass_d_nnz.push(owned);
-            mass_o_nnz.push(nb.len() - owned);
-        }
+        let (mass_d_nnz, mass_o_nnz) = dofs.vertex_neighbour_counts().into_iter().unzip();
         FieldLayout {
             displacement,
             pressure,
