@@ -8,6 +8,8 @@
 # on). Appends a row to bench/results/footing-adapt.csv and the invocation to
 # bench/results/footing-adapt.commands.
 #
+# EXTRA: further `--set` overrides, separated by ';' (applied last), e.g. EXTRA='mesh.fine=[]'.
+#
 # Usage: FACTOR=2 STEPS=100 RANKS=1 ADAPT='{h_min=0.125,h_max=1.0}' bench/adapt_footing.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -17,16 +19,19 @@ factor=${FACTOR:-1}
 steps=${STEPS:-100}
 ranks=${RANKS:-1}
 adapt=${ADAPT:-}
+extra=${EXTRA:-}
 timeout=${TIMEOUT:-3000}
 csv=$root/bench/results/footing-adapt.csv
-echo "FACTOR=$factor STEPS=$steps RANKS=$ranks ADAPT='$adapt' TIMEOUT=$timeout bench/adapt_footing.sh" \
+echo "FACTOR=$factor STEPS=$steps RANKS=$ranks ADAPT='$adapt'${extra:+ EXTRA='$extra'} TIMEOUT=$timeout bench/adapt_footing.sh" \
   >>"$root/bench/results/footing-adapt.commands"
-source bench/setup.sh "adapt_footing_f${factor}_n${steps}_r${ranks}${adapt:+_adapt}"
+source bench/setup.sh "adapt_footing_f${factor}_n${steps}_r${ranks}${adapt:+_adapt}${extra:+_extra}"
 mapfile -t mesh < <(python3 "$helper" mesh footing "$factor")
 mapfile -t push < <(python3 "$helper" push footing "$steps")
 sets=(--set 'solver.linear="direct"')
 for s in "${mesh[@]}" "${push[@]}"; do sets+=(--set "$s"); done
 [[ -z $adapt ]] || sets+=(--set "mesh.adapt=$adapt")
+IFS=';' read -ra more <<<"$extra"
+for s in "${more[@]}"; do sets+=(--set "$s"); done
 "$bin" new footing -o case.h5 "${sets[@]}" >new.log
 particles=$("$bin" info case.h5 | awk '/^particles/ {print $2}')
 code=0
@@ -45,4 +50,4 @@ else
   result="failed (exit $code, last step ${last:-none}): $(grep -m1 -i -E 'error|did not' run.log | cut -c1-160)"
 fi
 [[ -f $csv ]] || echo "factor,steps,ranks,adapt,particles_start,particles_end,cpu_s,newton_its,steps_cut,result" >"$csv"
-echo "$factor,$steps,$ranks,\"$adapt\",$particles,$last_particles,$cpu,$newton,$cuts,\"$result\"" | tee -a "$csv"
+echo "$factor,$steps,$ranks,\"$adapt${extra:+ $extra}\",$particles,$last_particles,$cpu,$newton,$cuts,\"$result\"" | tee -a "$csv"
