@@ -9,8 +9,8 @@ use crate::mesh::LocalMesh;
 use pfem_partition::{max_f64, Comm};
 
 impl Simulation {
-    /// Collective. At the first remesh of every `every`-th step (not before the first step:
-    /// there is no solution yet) sets the owned particles' spacings from the displacement
+    /// Collective. At the first remesh after every `every` completed steps (none before the
+    /// first step: there is no solution yet) sets the owned particles' spacings from the displacement
     /// increments on `mesh`, the mesh of the current particles, and writes them (and the ghosts'
     /// copies) into `mesh.h`, for the refinement that follows. The mesh itself is kept: it was
     /// cut by the alpha shape with the spacings the particles have now, and a finer target

@@ -129,7 +129,7 @@ pub struct Mesh {
     pub adapt: Option<Adapt>,
 }
 
-/// `[mesh.adapt]`: every `every` steps, each particle's target spacing `h` is set from the
+/// `[mesh.adapt]`: after every `every` steps, each particle's target spacing `h` is set from the
 /// solution, between `h_min` and `h_max`, before the refinement splits and merges (so it needs
 /// `mesh.refine = true`). The indicator of a particle is the largest, over the triangles around
 /// it, of the engineering shear strain of the last step's displacement increment (the plastic
@@ -157,7 +157,8 @@ pub struct Adapt {
     /// Largest ratio of neighbouring spacings, 1.2 to 2. Default 1.5.
     #[serde(default = "default_grading")]
     pub grading: f64,
-    /// Adapt at the start of every this many steps (>= 1). Default 1.
+    /// Adapt after every this many steps (>= 1; at the start of steps every + 1,
+    /// 2 every + 1, ...). Default 1.
     #[serde(default = "default_every")]
     pub every: u32,
 }
