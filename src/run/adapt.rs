@@ -10,9 +10,9 @@ use pfem_partition::{max_f64, Comm};
 
 impl Simulation {
     /// Collective. At the first remesh after every `every` completed steps (none before the
-    /// first step: there is no solution yet) sets the owned particles' spacings from the displacement
-    /// increments on `mesh`, the mesh of the current particles, and writes them (and the ghosts'
-    /// copies) into `mesh.h`, for the refinement that follows. The mesh itself is kept: it was
+    /// first step: there is no solution yet) sets the owned particles' spacings from the
+    /// displacement increments on `mesh`, the mesh of the current particles, and writes them
+    /// (and the ghosts' copies) into `mesh.h`, for the refinement that follows. The mesh itself is kept: it was
     /// cut by the alpha shape with the spacings the particles have now, and a finer target
     /// there would open holes until the splits have made the particles that fine.
     pub(super) fn adapt_spacing(&mut self, world: &Comm, mesh: &mut LocalMesh) {
