@@ -465,6 +465,19 @@ def main():
         print(fmt(h_min(sys.argv[2], float(sys.argv[3]))))
     elif cmd == "push":
         print("\n".join(push_sets(sys.argv[2], int(sys.argv[3]))))
+    elif cmd == "measure":
+        # One run's figure and error from its history (bench/adapt_footing.sh).
+        value, value2, err, note = measure(sys.argv[2], history(sys.argv[3]))
+        text = f"value {value} error {'-' if err is None else f'{100 * err:.3g} %'}"
+        if sys.argv[2] == "footing":
+            # Also the worst step from z/B = 0.25 on (the sawtooth), as bench/VALIDATION.md
+            # quotes it.
+            rows, ref = history(sys.argv[3]), history(FOOTING_REF)
+            worst = max((abs(float(r["q_over_cu"]) / q - 1), float(r["z_over_B"])) for r in rows
+                        if float(r["z_over_B"]) >= 0.25 - 1e-9
+                        and (q := interp(ref, "z_over_B", "q_over_cu", float(r["z_over_B"]))))
+            text += f" worst_step {100 * worst[0]:.3g} % at z/B {worst[1]:.3g}"
+        print(f"{text} ({note})")
     elif cmd == "record":
         record(sys.argv[2], sys.argv[3:])
     elif cmd == "summary":

@@ -102,3 +102,46 @@ fn graded_cloud_meshes_without_holes_on_any_rank_count() {
         lines[0]
     );
 }
+
+/// `[mesh.adapt]` sets the spacings from the last step's solution with max reductions and
+/// bitwise ghost copies only, so the adapted and refined mesh of a checkpoint is the same on 1,
+/// 2 and 3 ranks; it must differ from the checkpoint's own cloud (the adaptation acts: the coarse
+/// footing refines round its edge from 355 particles).
+#[test]
+fn adapted_mesh_is_rank_count_independent() {
+    let dir = workdir("fp-adapt");
+    ok(
+        &dir,
+        1,
+        &[
+            "new",
+            "footing",
+            "-o",
+            "a.h5",
+            "--set",
+            "mesh.h=1.0",
+            "--set",
+            "mesh.fine=[{origin=[0.0,5.0],size=[5.0,5.0],h=0.5},{origin=[0.0,6.5],size=[2.5,3.5],h=0.25}]",
+            "--set",
+            "rigid[0].stages=[{to=[0.0,-0.2],steps=10}]",
+            "--set",
+            "mesh.adapt={h_min=0.125,h_max=1.0}",
+        ],
+    );
+    ok(&dir, 1, &["a.h5", "--until-step", "1"]);
+    let after = "a.out/checkpoints/step_000001.h5";
+    let lines = fingerprints(&dir, after);
+    assert_same("adapted footing", &lines);
+    let info = ok(&dir, 1, &["info", after]);
+    let before: u64 = info
+        .lines()
+        .find_map(|l| l.strip_prefix("particles"))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no particle count in:\n{info}"));
+    let adapted = count(&lines[0], "particles");
+    assert!(
+        adapted > 2 * before,
+        "the spacing should have been refined round the edge: {before} -> {adapted}"
+    );
+}

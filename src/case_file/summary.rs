@@ -63,10 +63,17 @@ pub fn render(
                 let _ = write!(model, ", cu = {} Pa", num(sc.material.cu));
             }
             line("material", model);
-            line(
-                "mesh",
-                format!("h = {} m, alpha = {}", num(sc.mesh.h), num(sc.mesh.alpha)),
-            );
+            let mut mesh = format!("h = {} m, alpha = {}", num(sc.mesh.h), num(sc.mesh.alpha));
+            if let Some(a) = &sc.mesh.adapt {
+                let _ = write!(
+                    mesh,
+                    ", adapted between h = {} and {} m after every {} step(s)",
+                    num(a.h_min),
+                    num(a.h_max),
+                    a.every
+                );
+            }
+            line("mesh", mesh);
             line(
                 "progress",
                 format!(

@@ -1,6 +1,7 @@
 //! Meshing of the particle cloud: exact predicates, Delaunay, alpha shape, the rank-local mesh,
 //! refinement and the rank-count independent fingerprint.
 
+pub mod adapt;
 pub mod alpha;
 pub mod delaunay;
 pub mod fingerprint;

@@ -2,6 +2,7 @@
 //! identically: they read only the rank-local mesh around owned particles (equal to the global
 //! mesh there) and break ties by global id. Applying them (new ids, moving state) is the driver's.
 
+use super::adapt::merge_priority;
 use super::LocalMesh;
 use std::collections::BTreeSet;
 
@@ -17,6 +18,12 @@ pub struct RefineParams {
     /// ...when a triangle around them has an angle below this (radians): smoothing repairs bad
     /// triangles and leaves a good cloud (a lattice) alone.
     pub smooth_below_angle: f64,
+    /// An interior particle closer than the merge distance to others goes only if it outranks
+    /// every close neighbour (`adapt::merge_priority`), instead of whenever one of them has a
+    /// smaller id: the removed particles are never neighbours, so a region whose spacing grows
+    /// past 2.5 times its particles' distance (`[mesh.adapt]` coarsening) thins out over a few
+    /// steps instead of losing all but one particle at once.
+    pub independent_merges: bool,
 }
 
 impl Default for RefineParams {
@@ -26,6 +33,7 @@ impl Default for RefineParams {
             merge_distance: 0.4,
             smooth: false,
             smooth_below_angle: 25f64.to_radians(),
+            independent_merges: false,
         }
     }
 }
@@ -158,10 +166,15 @@ pub fn plan(
             }
             continue;
         }
-        let close = nb.iter().any(|&q| {
-            mesh.gids[q as usize] < mesh.gids[p]
-                && dist(pu, q) < params.merge_distance * spacing(pu, q)
-        });
+        let near = |q: u32| dist(pu, q) < params.merge_distance * spacing(pu, q);
+        let close = if params.independent_merges {
+            let rank = |q: usize| merge_priority(mesh.gids[q]);
+            nb.iter().any(|&q| near(q))
+                && nb.iter().all(|&q| !near(q) || rank(q as usize) < rank(p))
+        } else {
+            nb.iter()
+                .any(|&q| mesh.gids[q as usize] < mesh.gids[p] && near(q))
+        };
         if close {
             remove.push(pu);
         } else if params.smooth
@@ -278,6 +291,34 @@ mod tests {
         assert!(!p.split.is_empty(), "the gap left at x = 2 has long edges");
         for [a, b] in &p.split {
             assert!(m.gids[*a as usize] < m.gids[*b as usize]);
+        }
+    }
+
+    #[test]
+    fn independent_merges_thin_a_crowded_region_without_emptying_it() {
+        // A lattice of spacing 1 whose spacing asks for 4: every interior particle is close to
+        // its neighbours. The id rule removes every interior particle (each has a neighbour with a
+        // smaller id).
+        let mut m = lattice(8, 8, 1.0, |_| [0.0, 0.0]);
+        m.h = vec![4.0; m.points.len()];
+        let by_id = plan(&m, |_| false, |_| false, |_| None, &RefineParams::default());
+        let interior = (0..m.n_owned).filter(|&p| !m.on_boundary[p]).count();
+        assert_eq!(by_id.remove.len(), interior);
+        let params = RefineParams {
+            independent_merges: true,
+            ..Default::default()
+        };
+        let spread = plan(&m, |_| false, |_| false, |_| None, &params);
+        assert!(!spread.remove.is_empty());
+        assert!(
+            spread.remove.len() <= interior / 3,
+            "{}",
+            spread.remove.len()
+        );
+        // No two removed particles are neighbours.
+        for t in &m.tris {
+            let gone = t.iter().filter(|v| spread.remove.contains(v)).count();
+            assert!(gone <= 1, "{t:?}");
         }
     }
 

@@ -1,5 +1,6 @@
 //! The PFEM step loop (the method's Fig. 1): remesh, map, solve, update, output, checkpoint.
 
+mod adapt;
 mod contact;
 mod error;
 mod output;

@@ -37,6 +37,7 @@ impl Simulation {
         }
         let params = RefineParams {
             smooth: settings.smooth,
+            independent_merges: settings.adapt.is_some(),
             ..Default::default()
         };
         let protected = |p: usize| {

@@ -45,6 +45,10 @@ pub struct Simulation {
     pub(super) last_nodes: std::cell::RefCell<std::collections::HashMap<[u64; 2], [f64; 3]>>,
     /// Owned triangles interpolated by `map` since the last step report.
     pub(super) remapped: std::cell::Cell<u64>,
+    /// The halo of the last mesh built (`build_mesh`), for exchanges on that mesh.
+    pub(super) halo: Option<pfem_partition::Halo>,
+    /// The step after which `[mesh.adapt]` last set the spacings (once per step, not per piece).
+    pub(super) adapted_at: Option<u64>,
     first_step: u64,
 }
 
@@ -111,6 +115,8 @@ impl Simulation {
             solver: Default::default(),
             last_nodes: Default::default(),
             remapped: Default::default(),
+            halo: None,
+            adapted_at: None,
         };
         if world.size() > 1 && !same_partition {
             sim.repartition(world, Repartition::Always)?;
@@ -140,9 +146,10 @@ impl Simulation {
     }
 
     /// Collective. Delaunay of owned particles plus halo, alpha shape, triangles around owned
-    /// particles.
+    /// particles; the spacings adapted first where `[mesh.adapt]` asks.
     pub fn remesh(&mut self, world: &Comm) -> Result<LocalMesh, RunError> {
-        let mesh = self.build_mesh(world)?;
+        let mut mesh = self.build_mesh(world)?;
+        self.adapt_spacing(world, &mut mesh);
         if self.refine(world, &mesh)? {
             return self.build_mesh(world);
         }
@@ -153,8 +160,9 @@ impl Simulation {
     pub(super) fn build_mesh(&mut self, world: &Comm) -> Result<LocalMesh, RunError> {
         let h_max = max_f64(world, self.particles.h.iter().copied().fold(0.0, f64::max));
         let width = halo_width(self.model.scene.mesh.alpha, h_max);
-        let (_halo, ghosts) = self.particles.ghosts(world, width)?;
+        let (halo, ghosts) = self.particles.ghosts(world, width)?;
         self.ghosts = ghosts;
+        self.halo = Some(halo);
         #[cfg(debug_assertions)]
         check_halo(world, &self.particles, &self.ghosts, width)?;
         let p = &self.particles;

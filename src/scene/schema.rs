@@ -124,6 +124,66 @@ pub struct Mesh {
     /// none.
     #[serde(default)]
     pub fine: Vec<FineRegion>,
+    /// Particle spacing that follows the solution (opt-in; default none): see [`Adapt`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adapt: Option<Adapt>,
+}
+
+/// `[mesh.adapt]`: after every `every` steps, each particle's target spacing `h` is set from the
+/// solution, between `h_min` and `h_max`, before the refinement splits and merges (so it needs
+/// `mesh.refine = true`). The indicator of a particle is the largest, over the triangles around
+/// it, of the engineering shear strain of the last step's displacement increment (the plastic
+/// strain increment where the clay yields), relative to its largest value over the body: at or
+/// above `refine_above` the target is `h_min`, at or below `coarsen_below` it is `h_max`, in
+/// between it is interpolated geometrically. Then no spacing may exceed `grading` times a
+/// mesh neighbour's. Where it is coarsened, an interior particle closer than 0.4 h to another
+/// goes only if no close interior neighbour outranks it (a hash of the global id), so a fine
+/// region thins out over a few steps instead of emptying at once.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Adapt {
+    /// `"shear_strain_increment"` (the only one; default).
+    #[serde(default)]
+    pub indicator: AdaptIndicator,
+    /// Finest and coarsest target spacing (m), 0 < h_min < h_max.
+    pub h_min: f64,
+    pub h_max: f64,
+    /// Fractions of the largest indicator, 0 < coarsen_below < refine_above <= 1.
+    /// Defaults 0.1 and 0.01.
+    #[serde(default = "default_refine_above")]
+    pub refine_above: f64,
+    #[serde(default = "default_coarsen_below")]
+    pub coarsen_below: f64,
+    /// Largest ratio of neighbouring spacings, 1.2 to 2. Default 1.5.
+    #[serde(default = "default_grading")]
+    pub grading: f64,
+    /// Adapt after every this many steps (>= 1; at the start of steps every + 1,
+    /// 2 every + 1, ...). Default 1.
+    #[serde(default = "default_every")]
+    pub every: u32,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AdaptIndicator {
+    #[default]
+    ShearStrainIncrement,
+}
+
+fn default_refine_above() -> f64 {
+    0.1
+}
+
+fn default_coarsen_below() -> f64 {
+    0.01
+}
+
+fn default_grading() -> f64 {
+    1.5
+}
+
+fn default_every() -> u32 {
+    1
 }
 
 fn default_alpha() -> f64 {

@@ -417,3 +417,69 @@ fn linear_solver_is_a_named_choice() {
     assert_eq!(e.field.as_deref(), Some("solver.linear"), "{e}");
     assert!(e.to_string().contains("gmres"), "{e}");
 }
+
+#[test]
+fn mesh_adapt_defaults_round_trip_and_bad_values_name_the_field() {
+    let s = with_sets(&["mesh.adapt={h_min=0.05,h_max=0.4}"]).unwrap();
+    let a = s.mesh.adapt.expect("adapt set");
+    assert_eq!((a.h_min, a.h_max), (0.05, 0.4));
+    assert_eq!(
+        (a.refine_above, a.coarsen_below, a.grading, a.every),
+        (0.1, 0.01, 1.5, 1)
+    );
+    assert_eq!(Scene::from_toml(&s.to_toml(), "x", &[]).unwrap(), s);
+    assert!(with_sets(&[]).unwrap().mesh.adapt.is_none());
+    assert!(!with_sets(&[]).unwrap().to_toml().contains("adapt"));
+    let cases = [
+        ("{h_min=0.0,h_max=0.4}", "mesh.adapt.h_min", "must be > 0"),
+        (
+            "{h_min=0.5,h_max=0.4}",
+            "mesh.adapt.h_max",
+            "larger than h_min",
+        ),
+        (
+            "{h_min=0.05,h_max=0.4,refine_above=1.5}",
+            "mesh.adapt.refine_above",
+            "(0, 1]",
+        ),
+        (
+            "{h_min=0.05,h_max=0.4,coarsen_below=0.2}",
+            "mesh.adapt.coarsen_below",
+            "smaller than refine_above",
+        ),
+        (
+            "{h_min=0.05,h_max=0.4,grading=3.0}",
+            "mesh.adapt.grading",
+            "[1.2, 2]",
+        ),
+        ("{h_min=0.05,h_max=0.4,every=0}", "mesh.adapt.every", ">= 1"),
+        ("{h_min=1e-6,h_max=0.4}", "mesh.adapt.h_min", "particles"),
+        (
+            "{h_min=0.05,h_max=0.4,indicator=\"error\"}",
+            "mesh.adapt.indicator",
+            "error",
+        ),
+        ("{h_min=0.05,h_max=0.4,hmin=0.1}", "mesh.adapt.hmin", "hmin"),
+    ];
+    for (value, field, needle) in cases {
+        let set = format!("mesh.adapt={value}");
+        let e = with_sets(&[&set]).unwrap_err();
+        assert_eq!(e.field.as_deref(), Some(field), "{set}: {e}");
+        assert!(e.to_string().contains(needle), "{set}: {e}");
+        assert!(e.to_string().contains("scene 'cantilever'"), "{e}");
+    }
+    let e = with_sets(&["mesh.refine=false", "mesh.adapt={h_min=0.05,h_max=0.4}"]).unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("mesh.adapt"), "{e}");
+    assert!(e.to_string().contains("mesh.refine"), "{e}");
+    // In a scene file, the file is named.
+    let e = edited(
+        "refine = true",
+        "refine = true\nadapt = { h_min = 0.05, h_max = 0.01 }",
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("scene 'cantilever.toml': field mesh.adapt.h_max"),
+        "{e}"
+    );
+}

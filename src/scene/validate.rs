@@ -68,6 +68,77 @@ fn dofs(path: FieldPath, dofs: &[Dof]) -> Result<(), Invalid> {
     Ok(())
 }
 
+/// `[mesh.adapt]`: spacings, fractions and grading in range, and refinement on to act on them.
+fn check_adapt(s: &Scene, a: &super::schema::Adapt) -> Result<(), Invalid> {
+    let at = FieldPath::key("mesh").join("adapt");
+    positive(at.join("h_min"), a.h_min)?;
+    positive(at.join("h_max"), a.h_max)?;
+    if a.h_max <= a.h_min {
+        return fail(
+            at.join("h_max"),
+            format!("must be larger than h_min = {} (got {})", a.h_min, a.h_max),
+        );
+    }
+    let fraction = |x: f64| x > 0.0 && x <= 1.0;
+    if !fraction(a.refine_above) {
+        return fail(
+            at.join("refine_above"),
+            format!(
+                "must be in (0, 1], a fraction of the largest indicator (got {})",
+                a.refine_above
+            ),
+        );
+    }
+    if !(fraction(a.coarsen_below) && a.coarsen_below < a.refine_above) {
+        return fail(
+            at.join("coarsen_below"),
+            format!(
+                "must be > 0 and smaller than refine_above = {} (got {})",
+                a.refine_above, a.coarsen_below
+            ),
+        );
+    }
+    if !(1.2..=2.0).contains(&a.grading) {
+        return fail(
+            at.join("grading"),
+            format!(
+                "must be in [1.2, 2] (got {}): the largest ratio of neighbouring spacings; \
+                 larger jumps leave triangles the alpha shape and refinement cannot keep good",
+                a.grading
+            ),
+        );
+    }
+    if a.every == 0 {
+        return fail(at.join("every"), "must be >= 1 (got 0)".to_string());
+    }
+    if !s.mesh.refine {
+        return fail(
+            at,
+            "needs mesh.refine = true: the adapted spacing acts through the refinement's \
+             splits and merges"
+                .to_string(),
+        );
+    }
+    let area: f64 = s
+        .body
+        .rectangles
+        .iter()
+        .map(|r| r.size[0] * r.size[1])
+        .sum();
+    let upper = area / (a.h_min * a.h_min);
+    if upper > MAX_PARTICLES as f64 {
+        return fail(
+            at.join("h_min"),
+            format!(
+                "h_min = {} could refine the body to about {upper:.3e} particles, more than the \
+                 limit of {MAX_PARTICLES} ({LIMIT_REASON})",
+                a.h_min
+            ),
+        );
+    }
+    Ok(())
+}
+
 /// Checks everything that can be checked without generating particles.
 fn check_fields(s: &Scene) -> Result<(), Invalid> {
     let root = FieldPath::default();
@@ -117,6 +188,9 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
                 format!("must be > 0 in both components (got {})", vec2(r.size)),
             );
         }
+    }
+    if let Some(a) = &s.mesh.adapt {
+        check_adapt(s, a)?;
     }
     positive(mesh.join("alpha"), s.mesh.alpha)?;
     if s.mesh.alpha < std::f64::consts::FRAC_1_SQRT_2 {
