@@ -120,9 +120,11 @@ fn real_option(name: &str, default: f64) -> Result<f64, PetscError> {
 }
 
 /// Whether the iterative P2 path uses the two-level p-multigrid ([`LinearSolver::PMultigrid`]):
-/// yes unless the PETSc option `-pfem_pmg false` (or `0`) asks for GAMG on the P2 system.
+/// yes unless the PETSc option `-pfem_pmg false` (or `0`) asks for GAMG on the P2 system, or
+/// the command line names its own preconditioner (`-pc_type`), which then replaces GAMG: the
+/// p-multigrid's tangent is BAIJ, which GAMG cannot coarsen.
 pub fn p_multigrid_from_options() -> Result<bool, PetscError> {
-    bool_option("-pfem_pmg", true)
+    Ok(bool_option("-pfem_pmg", true)? && option_string("-pc_type")?.is_none())
 }
 
 /// The PETSc option `name` as a boolean (`true`/`false`, `1`/`0`, ...), or `default`.
