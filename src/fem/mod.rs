@@ -3,6 +3,7 @@
 
 pub mod element;
 pub mod mixed;
+pub mod p1;
 pub mod p2;
 pub mod quadrature;
 pub mod recovery;

@@ -5,6 +5,7 @@
 //! largest indicator and copies the owners' spacings to the ghosts between gradation sweeps.
 
 use super::LocalMesh;
+use crate::fem::p1::gradient;
 use crate::scene::schema::Adapt;
 
 /// Engineering shear strain of a linear displacement field over a triangle,
@@ -12,17 +13,9 @@ use crate::scene::schema::Adapt;
 /// triangle's canonical vertex order (smallest global id first), so that the same triangle gives
 /// the same value on every rank.
 pub fn triangle_shear(x: [[f64; 2]; 3], u: [[f64; 2]; 3]) -> f64 {
-    let d1 = [x[1][0] - x[0][0], x[1][1] - x[0][1]];
-    let d2 = [x[2][0] - x[0][0], x[2][1] - x[0][1]];
-    let det = d1[0] * d2[1] - d1[1] * d2[0];
-    if det == 0.0 || !det.is_finite() {
+    let (Some(gu), Some(gv)) = (gradient(x, u.map(|v| v[0])), gradient(x, u.map(|v| v[1]))) else {
         return 0.0;
-    }
-    let grad = |k: usize| {
-        let (a, b) = (u[1][k] - u[0][k], u[2][k] - u[0][k]);
-        [(a * d2[1] - b * d1[1]) / det, (b * d1[0] - a * d2[0]) / det]
     };
-    let (gu, gv) = (grad(0), grad(1));
     (gu[0] - gv[1]).hypot(gu[1] + gv[0])
 }
 

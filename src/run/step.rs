@@ -42,7 +42,6 @@ struct PMultigrid {
     space: CoarseSpace,
     interpolation: Mat,
     coarse: Mat,
-    near_null: Option<NullSpace>,
 }
 
 /// The Schur-complement field split of a mixed system.
@@ -344,7 +343,6 @@ impl Simulation {
                 space,
                 interpolation,
                 coarse,
-                near_null: None,
             })
         } else {
             None
@@ -465,6 +463,7 @@ impl Simulation {
         step: u64,
     ) -> Result<Outcome, SolveError> {
         let err = |e: String| SolveError::Fatal(e);
+        let iterative = objects.iterative();
         let SolverObjects {
             x,
             jac,
@@ -475,7 +474,6 @@ impl Simulation {
             pmg,
             ..
         } = objects;
-        let iterative = *amg || split.is_some() || pmg.is_some();
         if let Some(m) = pmg {
             fill_p_multigrid(world, mesh, dofs, &setup, m).map_err(err)?;
         }
@@ -838,7 +836,7 @@ fn fill_p_multigrid(
     mesh: &LocalMesh,
     dofs: &DofMap,
     setup: &StepSetup,
-    m: &mut PMultigrid,
+    m: &PMultigrid,
 ) -> Result<(), String> {
     let petsc = |e: PetscError| e.to_string();
     let to_int = |v: usize| crate::petsc::matrix::to_int(v, "dof").map_err(petsc);
@@ -893,8 +891,7 @@ fn fill_p_multigrid(
     }
     a.assemble().map_err(petsc)?;
     let modes = orthonormal_rigid_body_modes(world, &m.space.coordinates(mesh, dofs));
+    // The matrix holds its own reference to the space.
     let space = NullSpace::new(world, m.space.n_owned, &modes).map_err(petsc)?;
-    m.coarse.set_near_null_space(&space).map_err(petsc)?;
-    m.near_null = Some(space);
-    Ok(())
+    m.coarse.set_near_null_space(&space).map_err(petsc)
 }

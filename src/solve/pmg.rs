@@ -7,6 +7,7 @@
 //! rigid-body modes of its own nodes for the AMG that solves it.
 
 use super::{Constraints, DofMap};
+use crate::fem::p1;
 use crate::material::{GaussState, Material};
 use crate::mesh::LocalMesh;
 use pfem_partition::{allgather_u64, exscan_u64, Comm, PartitionError};
@@ -136,7 +137,7 @@ impl CoarseSpace {
                     }
                 }
             }
-            let k = p1_stiffness(&x, &d);
+            let k = p1::stiffness(&x, &d);
             let cols: Vec<usize> = (0..6).map(|j| self.coarse_dof[v[j / 2]] + j % 2).collect();
             rows.clear();
             vals.clear();
@@ -194,80 +195,4 @@ fn interpolation_ends(dofs: &DofMap, n: usize) -> Vec<(usize, f64)> {
         (dofs.node_of_point[a as usize] as usize, 0.5),
         (dofs.node_of_point[b as usize] as usize, 0.5),
     ]
-}
-
-/// The plane-strain stiffness of a linear triangle with vertices `x` and tangent `d` (Voigt
-/// xx, yy, engineering xy), dofs (node0 ux, node0 uy, node1 ux, ...).
-pub fn p1_stiffness(x: &[[f64; 2]; 3], d: &[[f64; 3]; 3]) -> [[f64; 6]; 6] {
-    let det = (x[1][0] - x[0][0]) * (x[2][1] - x[0][1]) - (x[2][0] - x[0][0]) * (x[1][1] - x[0][1]);
-    let area = 0.5 * det.abs();
-    // ∇N_a = (y_b − y_c, x_c − x_b) / det for (a, b, c) cyclic.
-    let grad: [[f64; 2]; 3] = std::array::from_fn(|a| {
-        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
-        [(x[b][1] - x[c][1]) / det, (x[c][0] - x[b][0]) / det]
-    });
-    let mut strain = [[0.0; 6]; 3];
-    for (a, g) in grad.iter().enumerate() {
-        strain[0][2 * a] = g[0];
-        strain[1][2 * a + 1] = g[1];
-        strain[2][2 * a] = g[1];
-        strain[2][2 * a + 1] = g[0];
-    }
-    let mut k = [[0.0; 6]; 6];
-    for (i, ki) in k.iter_mut().enumerate() {
-        for (j, kij) in ki.iter_mut().enumerate() {
-            let mut s = 0.0;
-            for p in 0..3 {
-                for q in 0..3 {
-                    s += strain[p][i] * d[p][q] * strain[q][j];
-                }
-            }
-            *kij = area * s;
-        }
-    }
-    k
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn d(e: f64, nu: f64) -> [[f64; 3]; 3] {
-        let l = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
-        let m = e / (2.0 * (1.0 + nu));
-        [[l + 2.0 * m, l, 0.0], [l, l + 2.0 * m, 0.0], [0.0, 0.0, m]]
-    }
-
-    fn apply(k: &[[f64; 6]; 6], u: &[f64; 6]) -> [f64; 6] {
-        std::array::from_fn(|i| (0..6).map(|j| k[i][j] * u[j]).sum())
-    }
-
-    #[test]
-    fn rigid_body_modes_cost_nothing_and_a_stretch_gives_its_force() {
-        let x = [[0.1, 0.2], [1.3, 0.1], [0.4, 0.9]];
-        let (e, nu) = (10.0e6, 0.3);
-        let k = p1_stiffness(&x, &d(e, nu));
-        let scale = e;
-        for mode in [
-            [1.0, 0.0, 1.0, 0.0, 1.0, 0.0],
-            [0.0, 1.0, 0.0, 1.0, 0.0, 1.0],
-            std::array::from_fn(|i| {
-                if i % 2 == 0 {
-                    -x[i / 2][1]
-                } else {
-                    x[i / 2][0]
-                }
-            }),
-        ] {
-            let f = apply(&k, &mode);
-            assert!(f.iter().all(|v| v.abs() < 1e-9 * scale), "{f:?}");
-        }
-        // A uniform stretch εxx = 1e-3: strain energy ½ (λ + 2μ) ε² × area.
-        let u: [f64; 6] =
-            std::array::from_fn(|i| if i % 2 == 0 { 1e-3 * x[i / 2][0] } else { 0.0 });
-        let energy = 0.5 * u.iter().zip(apply(&k, &u)).map(|(a, b)| a * b).sum::<f64>();
-        let area = 0.5 * ((1.3 - 0.1) * (0.9 - 0.2) - (0.4 - 0.1) * (0.1 - 0.2));
-        let want = 0.5 * d(e, nu)[0][0] * 1e-6 * area;
-        assert!((energy - want).abs() < 1e-12 * want, "{energy} vs {want}");
-    }
 }

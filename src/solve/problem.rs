@@ -795,11 +795,9 @@ impl StepProblem<'_> {
                 self.setup.material,
             )
             .unwrap_or(f64::INFINITY);
-            let area = 0.5
-                * ((x[1][0] - x[0][0]) * (x[2][1] - x[0][1])
-                    - (x[1][1] - x[0][1]) * (x[2][0] - x[0][0]));
+            let area = crate::fem::p1::area(&[x[0], x[1], x[2]]);
             let factor = -scale * scale * (1.0 / g.max(f64::MIN_POSITIVE) + 1.0 / bulk);
-            let mass = super::split::p1_mass(area.abs());
+            let mass = super::split::p1_mass(area);
             let cols = nodes[..3]
                 .iter()
                 .map(|&n| to_int(schur.pressure_index[n as usize], "pressure"))
