@@ -487,7 +487,8 @@ fn reused_factorisations_solve_the_mixed_plastic_footing() {
 fn the_p_multigrid_takes_fewer_krylov_iterations_than_gamg_on_2_ranks() {
     // A coarse level with a wrong numbering on several ranks or without its rotations still
     // converges, so equal histories cannot catch it; its iteration count does. Measured on
-    // this case (h = 1/32, one step of 50): 112 against 153 CG iterations.
+    // this case (h = 1/32, one step of 50): 80 against 152 CG iterations (112 with the
+    // start-of-step P1 stiffness as the coarse operator and one GAMG cycle).
     let dir = workdir("iterative-pmg-count");
     ok(
         &dir,
@@ -515,7 +516,52 @@ fn the_p_multigrid_takes_fewer_krylov_iterations_than_gamg_on_2_ranks() {
     println!("p-multigrid {pmg} CG iterations in {n_pmg} Newton, GAMG {gamg} in {n_gamg}");
     assert_eq!(n_pmg, n_gamg, "the same Newton iterations");
     assert!(
-        (pmg as f64) < 0.85 * gamg as f64,
+        (pmg as f64) < 0.7 * gamg as f64,
         "p-multigrid {pmg} against GAMG {gamg} CG iterations"
+    );
+}
+
+#[test]
+fn the_coarse_operator_follows_the_tangent_through_a_large_rotation() {
+    // With the coarse level solved exactly, the two-level method converges in a few Krylov
+    // iterations whatever the tangent, as long as the coarse operator is the Galerkin product
+    // of the current one. The cantilever's first increment of five rotates the tip by about
+    // 30 degrees. Measured here (h = 1/32, 2 ranks, step 1): 101 CG iterations in 8 Newton
+    // iterations; with the start-of-step P1 stiffness as the coarse operator, 539.
+    let dir = workdir("iterative-pmg-galerkin");
+    ok(
+        &dir,
+        1,
+        &[
+            "new",
+            "cantilever",
+            "-o",
+            "c.h5",
+            "--set",
+            "mesh.h=0.03125",
+            "--set",
+            "steps.count=5",
+            "--set",
+            "solver.linear=\"iterative\"",
+        ],
+    );
+    let args = [
+        "c.h5",
+        "--out",
+        "o",
+        "--until-step",
+        "1",
+        "--",
+        "-mg_coarse_pc_type",
+        "lu",
+        "-mg_coarse_pc_factor_mat_solver_type",
+        "mumps",
+    ];
+    let (newton, linear) = iterations(&ok(&dir, 2, &args));
+    println!("exact coarse solve: {linear} CG iterations in {newton} Newton iterations");
+    assert!(newton >= 5, "a large increment: {newton} Newton iterations");
+    assert!(
+        linear < 20 * newton,
+        "{linear} CG iterations in {newton} Newton iterations"
     );
 }

@@ -262,6 +262,37 @@ impl MatRef<'_> {
         )
     }
 
+    /// Adds a dense block `vals` (row-major, 2 rows.len() x 2 cols.len()) at the 2 × 2 blocks
+    /// `rows` x `cols` (block indices) of a matrix with block size 2: one search per block
+    /// instead of one per entry.
+    pub fn add_blocks(
+        &self,
+        rows: &[Int],
+        cols: &[Int],
+        vals: &[Scalar],
+    ) -> Result<(), PetscError> {
+        assert_eq!(
+            vals.len(),
+            4 * rows.len() * cols.len(),
+            "a dense block of 2 x 2 blocks"
+        );
+        // SAFETY: slices are valid for the stated lengths; PETSc copies the values.
+        check(
+            unsafe {
+                ffi::MatSetValuesBlocked(
+                    self.raw,
+                    to_int(rows.len(), "rows")?,
+                    rows.as_ptr(),
+                    to_int(cols.len(), "columns")?,
+                    cols.as_ptr(),
+                    vals.as_ptr(),
+                    ffi::InsertMode_ADD_VALUES,
+                )
+            },
+            "MatSetValuesBlocked",
+        )
+    }
+
     /// Collective. Final assembly.
     pub fn assemble(&self) -> Result<(), PetscError> {
         // SAFETY: live matrix.

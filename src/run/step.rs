@@ -12,7 +12,9 @@ use crate::petsc::{
 use crate::scene::{LineSearch, LinearChoice};
 use crate::solve::nullspace::orthonormal_rigid_body_modes;
 use crate::solve::pmg::CoarseSpace;
-use crate::solve::{Constraints, DofMap, FieldLayout, SchurPreconditioner, StepProblem, StepSetup};
+use crate::solve::{
+    CoarseOperator, Constraints, DofMap, FieldLayout, SchurPreconditioner, StepProblem, StepSetup,
+};
 use mpi::traits::Communicator;
 use pfem_partition::{max_f64, sum_f64, Comm};
 
@@ -336,8 +338,8 @@ impl Simulation {
                 world,
                 space.n_owned,
                 2,
-                &space.stiffness_d_nnz,
-                &space.stiffness_o_nnz,
+                &space.operator_d_nnz,
+                &space.operator_o_nnz,
             )?;
             Some(PMultigrid {
                 space,
@@ -481,6 +483,12 @@ impl Simulation {
             StepProblem::new(world, mesh, dofs, setup, x).map_err(|e| err(e.to_string()))?;
         if iterative {
             problem = problem.without_element_cache();
+        }
+        if let Some(m) = pmg {
+            problem = problem.with_coarse_operator(CoarseOperator {
+                matrix: &m.coarse,
+                space: &m.space,
+            });
         }
         if let Some(split) = split {
             problem = problem.with_schur_preconditioner(SchurPreconditioner {
@@ -829,8 +837,9 @@ fn owned_area(mesh: &LocalMesh, du: &[[f64; 2]], dofs: &DofMap) -> f64 {
     area
 }
 
-/// Collective. The p-multigrid's interpolation and P1 stiffness for this increment (start-of-step
-/// geometry, constraints and tangent), the stiffness with its rigid-body near-null space.
+/// Collective. The p-multigrid's interpolation for this increment (start-of-step geometry and
+/// constraints) and its coarse level's rigid-body near-null space; the coarse operator itself
+/// is assembled with every Jacobian ([`CoarseOperator`]).
 fn fill_p_multigrid(
     world: &Comm,
     mesh: &LocalMesh,
@@ -843,53 +852,22 @@ fn fill_p_multigrid(
     let ints = |v: &[usize]| -> Result<Vec<crate::petsc::Int>, String> {
         v.iter().map(|&g| to_int(g)).collect()
     };
-    let (p, a) = (m.interpolation.as_ref(), m.coarse.as_ref());
+    let p = m.interpolation.as_ref();
     p.zero_entries().map_err(petsc)?;
-    a.zero_entries().map_err(petsc)?;
     // Rank-local insertions; a failure on any rank is agreed on before the collective
-    // assemblies, so that no rank waits in one alone.
-    let local = m
-        .space
-        .interpolation(dofs, setup.constraints, |r, c, w| {
-            p.add_values(&[to_int(r)?], &ints(c)?, w).map_err(petsc)
-        })
-        .and_then(|()| {
-            m.space.stiffness(
-                mesh,
-                dofs,
-                (setup.constraints, setup.states_n, setup.material),
-                |rows, cols, vals| {
-                    a.add_values(&ints(rows)?, &ints(cols)?, vals)
-                        .map_err(petsc)
-                },
-            )
-        });
+    // assembly, so that no rank waits in it alone.
+    let local = m.space.interpolation(dofs, setup.constraints, |r, c, w| {
+        p.add_values(&[to_int(r)?], &ints(c)?, w).map_err(petsc)
+    });
     let failed = sum_f64(world, &[if local.is_err() { 1.0 } else { 0.0 }])[0];
-    let (sum, count) = match local {
-        Ok(s) if failed == 0.0 => s,
-        Ok(_) => return Err("the p-multigrid's coarse level failed on another rank".into()),
+    match local {
         Err(e) => return Err(e),
-    };
-    p.assemble().map_err(petsc)?;
-    let totals = sum_f64(world, &[sum, count as f64]);
-    let diagonal = if totals[1] > 0.0 {
-        totals[0] / totals[1]
-    } else {
-        1.0
-    };
-    let fixed = m
-        .space
-        .fixed_rows(dofs, setup.constraints)
-        .into_iter()
-        .try_for_each(|r| {
-            a.add_values(&[to_int(r)?], &[to_int(r)?], &[diagonal])
-                .map_err(petsc)
-        });
-    if sum_f64(world, &[if fixed.is_err() { 1.0 } else { 0.0 }])[0] > 0.0 {
-        fixed?;
-        return Err("the p-multigrid's coarse level failed on another rank".into());
+        Ok(()) if failed > 0.0 => {
+            return Err("the p-multigrid's interpolation failed on another rank".into())
+        }
+        Ok(()) => {}
     }
-    a.assemble().map_err(petsc)?;
+    p.assemble().map_err(petsc)?;
     let modes = orthonormal_rigid_body_modes(world, &m.space.coordinates(mesh, dofs));
     // The matrix holds its own reference to the space.
     let space = NullSpace::new(world, m.space.n_owned, &modes).map_err(petsc)?;

@@ -10,5 +10,5 @@ pub mod split;
 
 pub use constraints::Constraints;
 pub use dofs::DofMap;
-pub use problem::{Kernel, SchurPreconditioner, StepProblem, StepSetup};
+pub use problem::{CoarseOperator, Kernel, SchurPreconditioner, StepProblem, StepSetup};
 pub use split::FieldLayout;

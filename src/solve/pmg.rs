@@ -1,18 +1,21 @@
 //! The coarse level of a two-level p-multigrid for P2 displacements: P1 on the particles. The
 //! P2 mesh's vertex nodes are its nodes, and since a midside node sits at its edge's midpoint
 //! when the increment starts, P1 → P2 interpolation is exact: a vertex takes its own value, an
-//! edge node the mean of its two ends. The coarse operator is the P1 stiffness of the same
-//! triangles (rediscretised, not a Galerkin product of the P2 matrix, which couples a vertex
-//! with its second ring of neighbours), so it is as sparse as a P1 matrix and carries the
-//! rigid-body modes of its own nodes for the AMG that solves it.
+//! edge node the mean of its two ends. The coarse operator is the Galerkin product Pᵀ A P of
+//! each Newton iterate's tangent A, formed triangle by triangle (Rᵀ K R): an edge node
+//! interpolates from its own edge's ends, so the product has a P1 matrix's sparsity. It
+//! follows the tangent through large rotations and yield, where the P1 stiffness of the
+//! start-of-step geometry (the first version) left the cantilever's CG iterations per Newton
+//! iteration growing from 21 to 98 within one large increment. It carries the rigid-body modes
+//! of its own nodes for the AMG that solves it.
 
 use super::{Constraints, DofMap};
-use crate::fem::p1;
-use crate::material::{GaussState, Material};
+use crate::fem::element::N_DOFS;
+use crate::fem::p2::EDGES;
 use crate::mesh::LocalMesh;
 use pfem_partition::{allgather_u64, exscan_u64, Comm, PartitionError};
 
-/// The P1 space on this rank: numbering, interpolation pattern and stiffness pattern.
+/// The P1 space on this rank: numbering, interpolation pattern and coarse operator pattern.
 pub struct CoarseSpace {
     /// Owned coarse dofs (2 per owned vertex node).
     pub n_owned: usize,
@@ -22,9 +25,9 @@ pub struct CoarseSpace {
     /// Per owned P2 row of the interpolation, nonzeros in owned and in other ranks' columns.
     pub interpolation_d_nnz: Vec<usize>,
     pub interpolation_o_nnz: Vec<usize>,
-    /// Per owned coarse row of the stiffness, nonzeros in owned and in other ranks' columns.
-    pub stiffness_d_nnz: Vec<usize>,
-    pub stiffness_o_nnz: Vec<usize>,
+    /// Per owned coarse row of the coarse operator, nonzeros in owned and in other ranks' columns.
+    pub operator_d_nnz: Vec<usize>,
+    pub operator_o_nnz: Vec<usize>,
 }
 
 impl CoarseSpace {
@@ -59,11 +62,11 @@ impl CoarseSpace {
                 interpolation_o_nnz.push(ends.len() - inside);
             }
         }
-        let (mut stiffness_d_nnz, mut stiffness_o_nnz) = (Vec::new(), Vec::new());
+        let (mut operator_d_nnz, mut operator_o_nnz) = (Vec::new(), Vec::new());
         for (owned, other) in dofs.vertex_neighbour_counts() {
             for _ in 0..2 {
-                stiffness_d_nnz.push(2 * owned);
-                stiffness_o_nnz.push(2 * other);
+                operator_d_nnz.push(2 * owned);
+                operator_o_nnz.push(2 * other);
             }
         }
         Ok(CoarseSpace {
@@ -71,8 +74,8 @@ impl CoarseSpace {
             coarse_dof,
             interpolation_d_nnz,
             interpolation_o_nnz,
-            stiffness_d_nnz,
-            stiffness_o_nnz,
+            operator_d_nnz,
+            operator_o_nnz,
         })
     }
 
@@ -102,63 +105,61 @@ impl CoarseSpace {
         Ok(())
     }
 
-    /// Hands `add` the P1 stiffness of every triangle with an owned vertex, on the start-of-step
-    /// geometry, with the material's tangent at the start of the step (the mean over a
-    /// triangle's Gauss points, at zero step strain): the rows of its owned vertices (global
-    /// rows, the triangle's six global columns, row-major values). Rows and columns of
-    /// prescribed coarse dofs are zero (their diagonal is the caller's). Returns the sum and
-    /// the count of this rank's free diagonal entries, for that diagonal.
-    pub fn stiffness(
+    /// Hands `add` the Galerkin coarse operator Rᵀ K R of triangle `t` whose P2 tangent is `k`
+    /// (row-major, 12 × 12, the element's dof order), R the triangle's own P1 → P2
+    /// interpolation: the rows of its owned vertices as 2 × 2 blocks (global block rows, the
+    /// triangle's three global block columns, row-major values). Summed over the triangles this is exactly Pᵀ A P of the
+    /// assembled tangent A, since a midside node interpolates from the ends of its own edge,
+    /// so it has the sparsity of a P1 matrix and follows the tangent of every Newton iterate
+    /// (large rotations, yield). Prescribed P2 dofs take no part (zero rows of P), and rows
+    /// and columns of prescribed coarse dofs are zero (their diagonal is the caller's).
+    /// Returns the sum of the free diagonal entries added.
+    pub fn galerkin_element<E>(
         &self,
-        mesh: &LocalMesh,
         dofs: &DofMap,
-        setup: (&Constraints, &[[GaussState; 3]], &dyn Material),
-        mut add: impl FnMut(&[usize], &[usize], &[f64]) -> Result<(), String>,
-    ) -> Result<(f64, usize), String> {
-        let (constraints, states_n, material) = setup;
-        let fixed = |n: usize, c: usize| constraints.fixed[n][c].is_some();
-        let mut diagonal_sum = 0.0;
-        let (mut rows, mut vals) = (Vec::with_capacity(6), Vec::with_capacity(36));
-        for (t, nodes) in dofs.tri_nodes.iter().enumerate() {
-            let v: [usize; 3] = std::array::from_fn(|k| nodes[k] as usize);
-            if v.iter().all(|&n| !dofs.node_owned[n]) {
-                continue;
-            }
-            let x = v.map(|n| mesh.points[dofs.node_point[n] as usize]);
-            let mut d = [[0.0; 3]; 3];
-            for state in &states_n[t] {
-                let full = material
-                    .update(state, &[0.0; 4])
-                    .map_err(|e| format!("coarse stiffness, triangle {t}: {e}"))?
-                    .d;
-                for (i, &a) in [0, 1, 3].iter().enumerate() {
-                    for (j, &b) in [0, 1, 3].iter().enumerate() {
-                        d[i][j] += full[a][b] / 3.0;
-                    }
-                }
-            }
-            let k = p1::stiffness(&x, &d);
-            let cols: Vec<usize> = (0..6).map(|j| self.coarse_dof[v[j / 2]] + j % 2).collect();
-            rows.clear();
-            vals.clear();
-            for i in (0..6).filter(|&i| dofs.node_owned[v[i / 2]]) {
-                rows.push(cols[i]);
-                let row_fixed = fixed(v[i / 2], i % 2);
-                for j in 0..6 {
-                    let free = !row_fixed && !fixed(v[j / 2], j % 2);
-                    vals.push(if free { k[i][j] } else { 0.0 });
-                }
-                if !row_fixed {
-                    diagonal_sum += k[i][i];
-                }
-            }
-            add(&rows, &cols, &vals)?;
+        constraints: &Constraints,
+        t: usize,
+        k: &[f64],
+        mut add: impl FnMut(&[usize], &[usize], &[f64]) -> Result<(), E>,
+    ) -> Result<f64, E> {
+        let nodes = &dofs.tri_nodes[t];
+        let v: [usize; 3] = std::array::from_fn(|a| nodes[a] as usize);
+        if v.iter().all(|&n| !dofs.node_owned[n]) {
+            return Ok(0.0);
         }
-        let diagonal_count = (0..n_vertex_nodes(dofs))
+        let fixed = |n: usize, c: usize| constraints.fixed[n][c].is_some();
+        let coarse = galerkin_product(
+            k,
+            std::array::from_fn(|d| !fixed(nodes[d / 2] as usize, d % 2)),
+            std::array::from_fn(|d| !fixed(v[d / 2], d % 2)),
+        );
+        // Coarse dofs come in (x, y) pairs at (2 b, 2 b + 1): whole 2 × 2 blocks.
+        let blocks: [usize; 3] = std::array::from_fn(|a| self.coarse_dof[v[a]] / 2);
+        let (mut rows, mut vals) = (Vec::with_capacity(3), Vec::with_capacity(36));
+        let mut diagonal_sum = 0.0;
+        for a in (0..3).filter(|&a| dofs.node_owned[v[a]]) {
+            rows.push(blocks[a]);
+            for i in [2 * a, 2 * a + 1] {
+                vals.extend_from_slice(&coarse[i]);
+                if !fixed(v[a], i % 2) {
+                    diagonal_sum += coarse[i][i];
+                }
+            }
+        }
+        add(&rows, &blocks, &vals)?;
+        Ok(diagonal_sum)
+    }
+
+    /// The number of free coarse dofs this rank owns (for the mean of their diagonal).
+    pub fn free_count(&self, dofs: &DofMap, constraints: &Constraints) -> usize {
+        (0..n_vertex_nodes(dofs))
             .filter(|&n| dofs.node_owned[n])
-            .map(|n| (0..2).filter(|&c| !fixed(n, c)).count())
-            .sum();
-        Ok((diagonal_sum, diagonal_count))
+            .map(|n| {
+                (0..2)
+                    .filter(|&c| constraints.fixed[n][c].is_none())
+                    .count()
+            })
+            .sum()
     }
 
     /// The prescribed coarse dofs this rank owns (their rows get the diagonal alone).
@@ -180,6 +181,50 @@ impl CoarseSpace {
     }
 }
 
+/// Rᵀ K R for the P2 triangle tangent `k` (row-major 12 × 12) and the triangle's P1 → P2
+/// interpolation R (a vertex its own value, a midside node the mean of its edge's ends), with
+/// the rows of R zero at fine dofs that are not `free_fine` and its columns zero at coarse dofs
+/// that are not `free_coarse`.
+pub fn galerkin_product(
+    k: &[f64],
+    free_fine: [bool; N_DOFS],
+    free_coarse: [bool; 6],
+) -> [[f64; 6]; 6] {
+    let n = N_DOFS;
+    assert_eq!(k.len(), n * n, "a P2 triangle tangent");
+    // R as (fine dof, coarse dof, weight) triples.
+    let mut r: Vec<(usize, usize, f64)> = Vec::with_capacity(18);
+    for m in 0..6 {
+        let ends: &[(usize, f64)] = if m < 3 {
+            &[(m, 1.0)]
+        } else {
+            let [a, b] = EDGES[m - 3];
+            &[(a, 0.5), (b, 0.5)]
+        };
+        for c in 0..2 {
+            for &(a, w) in ends {
+                if free_fine[2 * m + c] && free_coarse[2 * a + c] {
+                    r.push((2 * m + c, 2 * a + c, w));
+                }
+            }
+        }
+    }
+    // K R, 12 × 6.
+    let mut kr = [[0.0; 6]; N_DOFS];
+    for &(m, j, w) in &r {
+        for (i, row) in kr.iter_mut().enumerate() {
+            row[j] += w * k[i * n + m];
+        }
+    }
+    let mut coarse = [[0.0; 6]; 6];
+    for &(i, j, w) in &r {
+        for (cj, kij) in coarse[j].iter_mut().zip(kr[i].iter()) {
+            *cj += w * kij;
+        }
+    }
+    coarse
+}
+
 fn n_vertex_nodes(dofs: &DofMap) -> usize {
     dofs.n_nodes() - dofs.edges.len()
 }
@@ -195,4 +240,97 @@ fn interpolation_ends(dofs: &DofMap, n: usize) -> Vec<(usize, f64)> {
         (dofs.node_of_point[a as usize] as usize, 0.5),
         (dofs.node_of_point[b as usize] as usize, 0.5),
     ]
+}
+
+#[cfg(test)]
+// Index loops compare a matrix with its transpose.
+#[allow(clippy::needless_range_loop)]
+mod tests {
+    use super::*;
+    use crate::fem::element::p2_element;
+    use crate::fem::p2::straight_sided;
+    use crate::material::elastic::LinearElastic;
+    use crate::material::GaussState;
+
+    fn apply(k: &[[f64; 6]; 6], u: &[f64; 6]) -> [f64; 6] {
+        std::array::from_fn(|i| (0..6).map(|j| k[i][j] * u[j]).sum())
+    }
+
+    /// The P2 tangent of an unstressed elastic triangle at zero step.
+    fn p2_tangent(x: [[f64; 2]; 3], e: f64, nu: f64) -> Vec<f64> {
+        let m = LinearElastic::new(e, nu).unwrap();
+        let out = p2_element(
+            &straight_sided(&x),
+            &[[0.0; 2]; 6],
+            &[GaussState::default(); 3],
+            &m,
+            [0.0, 0.0],
+        )
+        .unwrap();
+        out.tangent.as_flattened().to_vec()
+    }
+
+    #[test]
+    fn the_galerkin_product_of_an_elastic_p2_triangle_is_its_p1_stiffness() {
+        // Linear fields are P2 fields, and the 3-point rule integrates their constant strain
+        // energy exactly: Rᵀ K R must be the P1 stiffness, which costs nothing for the rigid
+        // modes and gives a uniform stretch its strain energy.
+        let x = [[0.1, 0.2], [1.3, 0.1], [0.4, 0.9]];
+        let (e, nu) = (10.0e6, 0.3);
+        let k = galerkin_product(&p2_tangent(x, e, nu), [true; 12], [true; 6]);
+        for mode in [
+            [1.0, 0.0, 1.0, 0.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0, 1.0, 0.0, 1.0],
+            std::array::from_fn(|i| {
+                if i % 2 == 0 {
+                    -x[i / 2][1]
+                } else {
+                    x[i / 2][0]
+                }
+            }),
+        ] {
+            let f = apply(&k, &mode);
+            assert!(f.iter().all(|v| v.abs() < 1e-9 * e), "{f:?}");
+        }
+        let u: [f64; 6] =
+            std::array::from_fn(|i| if i % 2 == 0 { 1e-3 * x[i / 2][0] } else { 0.0 });
+        let energy = 0.5 * u.iter().zip(apply(&k, &u)).map(|(a, b)| a * b).sum::<f64>();
+        let lambda_2mu = e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
+        let want = 0.5 * lambda_2mu * 1e-6 * crate::fem::p1::area(&x);
+        assert!((energy - want).abs() < 1e-12 * want, "{energy} vs {want}");
+        for i in 0..6 {
+            for j in 0..6 {
+                assert!((k[i][j] - k[j][i]).abs() < 1e-9 * e, "symmetric");
+            }
+        }
+    }
+
+    #[test]
+    fn prescribed_dofs_take_no_part_in_the_galerkin_product() {
+        let x = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+        let tangent = p2_tangent(x, 1.0e6, 0.25);
+        let all = galerkin_product(&tangent, [true; 12], [true; 6]);
+        // Coarse dof 2 (vertex 1, x) prescribed: its row and column vanish, the rest stays.
+        let mut free_coarse = [true; 6];
+        free_coarse[2] = false;
+        let k = galerkin_product(&tangent, [true; 12], free_coarse);
+        for i in 0..6 {
+            for j in 0..6 {
+                let want = if i == 2 || j == 2 { 0.0 } else { all[i][j] };
+                assert!((k[i][j] - want).abs() < 1e-9, "({i}, {j})");
+            }
+        }
+        // A prescribed midside dof (node 3 on edge 0-1, y) drops out of the sum: the product
+        // changes exactly by its row and column's contributions, and stays symmetric.
+        let mut free_fine = [true; 12];
+        free_fine[7] = false;
+        let k = galerkin_product(&tangent, free_fine, [true; 6]);
+        let changed = (0..6).any(|i| (0..6).any(|j| (k[i][j] - all[i][j]).abs() > 1e-6));
+        assert!(changed);
+        for i in 0..6 {
+            for j in 0..6 {
+                assert!((k[i][j] - k[j][i]).abs() < 1e-9);
+            }
+        }
+    }
 }

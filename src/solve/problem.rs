@@ -3,6 +3,7 @@
 //! only its own rows, so assembly needs no off-rank communication and each row is summed in the
 //! same order whatever the partition.
 
+use super::pmg::CoarseSpace;
 use super::{Constraints, DofMap};
 use crate::fem::element::p2_element;
 use crate::fem::mixed::p2p1_element;
@@ -84,6 +85,8 @@ pub struct StepProblem<'a> {
     diagonal: Cell<Option<f64>>,
     /// Where the Jacobian also assembles the Schur-complement preconditioner.
     schur: Option<SchurPreconditioner<'a>>,
+    /// Where the Jacobian also assembles the p-multigrid's coarse operator.
+    coarse: Option<CoarseOperator<'a>>,
     /// The element results of the last residual and the local vector they belong to. SNES asks
     /// for the Jacobian at the iterate whose residual it has just evaluated, and the converged
     /// state is read at the last residual's iterate: each evaluation there was a second full
@@ -108,6 +111,13 @@ pub struct StepProblem<'a> {
 pub struct SchurPreconditioner<'a> {
     pub matrix: &'a Mat,
     pub pressure_index: &'a [usize],
+}
+
+/// The coarse level of the p-multigrid: its matrix, assembled with every Jacobian as the
+/// Galerkin product of the tangent ([`CoarseSpace::galerkin_element`]).
+pub struct CoarseOperator<'a> {
+    pub matrix: &'a Mat,
+    pub space: &'a CoarseSpace,
 }
 
 impl<'a> StepProblem<'a> {
@@ -161,6 +171,7 @@ impl<'a> StepProblem<'a> {
             dofs_per_element,
             diagonal: Cell::new(None),
             schur: None,
+            coarse: None,
             cache: RefCell::new(None),
             keep_elements: true,
             sorted_cols,
@@ -180,6 +191,12 @@ impl<'a> StepProblem<'a> {
     /// Assembles `schur` with every Jacobian (mixed kernels only).
     pub fn with_schur_preconditioner(mut self, schur: SchurPreconditioner<'a>) -> Self {
         self.schur = Some(schur);
+        self
+    }
+
+    /// Assembles the p-multigrid's coarse operator with every Jacobian (P2 kernel only).
+    pub fn with_coarse_operator(mut self, coarse: CoarseOperator<'a>) -> Self {
+        self.coarse = Some(coarse);
         self
     }
 
@@ -699,33 +716,82 @@ impl NonlinearProblem for StepProblem<'_> {
             .collect::<Result<Vec<Int>, _>>()
             .map_err(fatal)?;
         j.zero_entries().map_err(fatal)?;
+        if let Some(c) = &self.coarse {
+            c.matrix.as_ref().zero_entries().map_err(fatal)?;
+        }
+        let mut coarse_diagonal = 0.0;
+        // P2 displacements: every node carries x and y at consecutive global dofs (2 g, 2 g + 1).
+        let blocked = self.dofs_per_element == 12 && self.dofs.block_size() == 2;
+        let mut block_cols = Vec::with_capacity(6);
         let mut rows = Vec::new();
         let mut vals = Vec::new();
         let mut start = 0;
         let evaluated = self.evaluate(x, true, |t, e| {
+            if let Some(c) = &self.coarse {
+                let m = c.matrix.as_ref();
+                coarse_diagonal += c
+                    .space
+                    .galerkin_element(
+                        self.dofs,
+                        self.setup.constraints,
+                        t,
+                        &e.tangent,
+                        |rows, cols, vals| {
+                            let ints = |v: &[usize]| {
+                                v.iter()
+                                    .map(|&g| to_int(g, "coarse dof"))
+                                    .collect::<Result<Vec<Int>, _>>()
+                            };
+                            m.add_blocks(&ints(rows)?, &ints(cols)?, vals)
+                        },
+                    )
+                    .map_err(fatal)?;
+            }
             let n = e.residual.len();
             let cols = &self.sorted_cols[start..start + n];
             let order = &self.sorted_dofs[start..start + n];
             start += n;
+            // Prescribed columns are zeroed (not dropped, so the pattern stays): with the
+            // constrained rows holding only their diagonal, the matrix stays as symmetric as
+            // the tangent. Newton keeps prescribed dofs at their values, so their columns
+            // would multiply a zero update anyway.
+            let entry = |k: usize, c: u8| {
+                let c = c as usize;
+                if self.constrained_column(t, c) {
+                    0.0
+                } else {
+                    e.tangent[k * n + c]
+                }
+            };
             rows.clear();
             vals.clear();
+            if blocked {
+                // A node's two dofs are adjacent in the sorted order, x first: whole 2 × 2
+                // blocks, with zero rows where a component is prescribed.
+                block_cols.clear();
+                block_cols.extend(cols.iter().step_by(2).map(|&c| c / 2));
+                for (pair, &col) in order.chunks(2).zip(cols.iter().step_by(2)) {
+                    let node = self.dofs.tri_nodes[t][pair[0] as usize / 2] as usize;
+                    if !self.dofs.node_owned[node] {
+                        continue;
+                    }
+                    rows.push(col / 2);
+                    for &k in pair {
+                        let k = k as usize;
+                        let free = self.free_row(t, k).is_some();
+                        vals.extend(order.iter().map(|&c| if free { entry(k, c) } else { 0.0 }));
+                    }
+                }
+                if !rows.is_empty() {
+                    j.add_blocks(&rows, &block_cols, &vals).map_err(fatal)?;
+                }
+                return Ok(());
+            }
             for (&row, &k) in cols.iter().zip(order) {
                 let k = k as usize;
                 if self.free_row(t, k).is_some() {
                     rows.push(row);
-                    // Prescribed columns are zeroed (not dropped, so the pattern stays): with
-                    // the constrained rows holding only their diagonal, the matrix stays as
-                    // symmetric as the tangent. Newton keeps prescribed dofs at their values,
-                    // so their columns would multiply a zero update anyway.
-                    let tangent_row = &e.tangent[k * n..(k + 1) * n];
-                    vals.extend(order.iter().map(|&c| {
-                        let c = c as usize;
-                        if self.constrained_column(t, c) {
-                            0.0
-                        } else {
-                            tangent_row[c]
-                        }
-                    }));
+                    vals.extend(order.iter().map(|&c| entry(k, c)));
                 }
             }
             if !rows.is_empty() {
@@ -736,8 +802,11 @@ impl NonlinearProblem for StepProblem<'_> {
         let local = match evaluated {
             Ok(local) => local,
             Err(CallbackError::Domain(msg)) => {
-                // Every rank failed alike: leave the matrix assembled for the next attempt.
+                // Every rank failed alike: leave the matrices assembled for the next attempt.
                 j.assemble().map_err(fatal)?;
+                if let Some(c) = &self.coarse {
+                    c.matrix.as_ref().assemble().map_err(fatal)?;
+                }
                 return Err(CallbackError::Domain(msg));
             }
             Err(e) => return Err(e),
@@ -760,11 +829,41 @@ impl NonlinearProblem for StepProblem<'_> {
             self.assemble_schur_preconditioner(schur, &local)
                 .map_err(fatal)?;
         }
+        if let Some(c) = &self.coarse {
+            self.finish_coarse_operator(c, coarse_diagonal)
+                .map_err(fatal)?;
+        }
         j.assemble().map_err(fatal)
     }
 }
 
 impl StepProblem<'_> {
+    /// Collective. Gives the prescribed coarse rows the mean free coarse diagonal (from this
+    /// rank's sum of its free diagonal entries) and assembles the coarse operator. Contact and
+    /// follower pressures stay on the fine level: their terms sit on single nodes, which the
+    /// smoother reaches.
+    fn finish_coarse_operator(
+        &self,
+        c: &CoarseOperator,
+        diagonal_sum: f64,
+    ) -> Result<(), PetscError> {
+        let constraints = self.setup.constraints;
+        let count = c.space.free_count(self.dofs, constraints) as f64;
+        let totals = pfem_partition::sum_f64(self.comm, &[diagonal_sum, count]);
+        let mean = totals[0] / totals[1].max(1.0);
+        let diagonal = if mean.is_finite() && mean > 0.0 {
+            mean
+        } else {
+            1.0
+        };
+        let m = c.matrix.as_ref();
+        for r in c.space.fixed_rows(self.dofs, constraints) {
+            let r = to_int(r, "coarse dof")?;
+            m.add_values(&[r], &[r], &[diagonal])?;
+        }
+        m.assemble()
+    }
+
     /// Collective. The pressure mass matrix scaled by −(1/G_eff + 1/K) per triangle, in the
     /// scaled pressure unknown: the Schur complement −(K_pp + B A⁻¹ Bᵀ) of a solid with shear
     /// modulus G and bulk modulus K is spectrally close to it. G_eff is the current tangent's
