@@ -132,6 +132,26 @@ fn the_p2_iterative_path_is_a_p_multigrid_unless_asked_for_gamg() {
     ] {
         assert!(pmg.contains(want), "no '{want}' in\n{pmg}");
     }
+    // The cantilever's tangent is symmetric: only its upper triangle is stored, in blocks.
+    // Declared unsymmetric, the whole tangent is stored and GMRES replaces CG, with the same
+    // history.
+    assert!(pmg.contains("type: mpisbaij"), "no SBAIJ tangent in\n{pmg}");
+    let unsym = workdir("iterative-pmg-unsymmetric");
+    common::small_cantilever(
+        &unsym,
+        10,
+        &["solver.linear=\"iterative\"", "solver.symmetric=false"],
+    );
+    let full = ok(&unsym, 2, &["c.h5", "--until-step", "1", "--", "-ksp_view"]);
+    for want in ["type: mpibaij", "type: gmres", "type: mg"] {
+        assert!(full.contains(want), "no '{want}' in\n{full}");
+    }
+    assert!(!full.contains("sbaij"), "{full}");
+    let diff = max_relative_difference(
+        &dir.join("c.out/history.csv"),
+        &unsym.join("c.out/history.csv"),
+    );
+    assert!(diff < 1e-6, "BAIJ/GMRES against SBAIJ/CG: {diff:e}");
     // Asked for GAMG, or for any preconditioner on the command line (the p-multigrid's BAIJ
     // tangent would stop GAMG: "No method creategraph for Mat of type seqbaij").
     for asked in [&["-pfem_pmg", "false"][..], &["-pc_type", "gamg"][..]] {

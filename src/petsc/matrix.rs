@@ -113,6 +113,63 @@ impl Mat {
         }
     }
 
+    /// Collective. MPISBAIJ (SeqSBAIJ on one rank), a symmetric matrix of which only the upper
+    /// triangle is stored, in 2 × 2 blocks, with `n_local` owned rows and columns and, per owned
+    /// block row, `d_blocks` blocks in the owned columns on or right of the diagonal and
+    /// `o_blocks` in other ranks' columns right of it. Entries left of the diagonal are ignored
+    /// on insertion, so a caller adds whole element matrices. Half the memory of BAIJ, for
+    /// symmetric operators that are only multiplied and read on the diagonal.
+    pub fn sbaij(
+        comm: &SimpleCommunicator,
+        n_local: usize,
+        d_blocks: &[usize],
+        o_blocks: &[usize],
+    ) -> Result<Mat, PetscError> {
+        const BS: usize = 2;
+        assert_eq!(n_local % BS, 0, "whole blocks of rows");
+        assert_eq!(
+            d_blocks.len(),
+            n_local / BS,
+            "one count per owned block row"
+        );
+        assert_eq!(
+            o_blocks.len(),
+            n_local / BS,
+            "one count per owned block row"
+        );
+        let ints = |v: &[usize]| {
+            v.iter()
+                .map(|&k| to_int(k, "blocks per row"))
+                .collect::<Result<Vec<Int>, _>>()
+        };
+        let (d_nnz, o_nnz) = (ints(d_blocks)?, ints(o_blocks)?);
+        let bs = to_int(BS, "block size")?;
+        let mat = Mat::create(comm, [n_local, n_local], "sbaij")?;
+        let raw = mat.raw;
+        // SAFETY: live handle; the block counts have n_local / 2 entries and are copied by
+        // PETSc.
+        unsafe {
+            check(
+                ffi::MatSeqSBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr()),
+                "MatSeqSBAIJSetPreallocation",
+            )?;
+            check(
+                ffi::MatMPISBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()),
+                "MatMPISBAIJSetPreallocation",
+            )?;
+            strict_assembly(raw)?;
+            check(
+                ffi::MatSetOption(
+                    raw,
+                    ffi::MatOption_MAT_IGNORE_LOWER_TRIANGULAR,
+                    ffi::PetscBool_PETSC_TRUE,
+                ),
+                "MatSetOption(MAT_IGNORE_LOWER_TRIANGULAR)",
+            )?;
+            Ok(mat)
+        }
+    }
+
     /// Collective. An empty matrix of type `kind` with `local[0]` owned rows and `local[1]`
     /// owned columns.
     fn create(comm: &SimpleCommunicator, local: [usize; 2], kind: &str) -> Result<Mat, PetscError> {

@@ -349,11 +349,16 @@ impl Simulation {
         } else {
             None
         };
-        let (d_nnz, o_nnz) = dofs.preallocation();
-        // The p-multigrid only multiplies by the P2 tangent and reads its diagonal.
-        let jac = if pmg.is_some() {
+        // The p-multigrid only multiplies by the P2 tangent and reads its diagonal: blocks,
+        // and only the upper triangle of a symmetric one.
+        let jac = if pmg.is_some() && self.symmetric_tangent() {
+            let (d_blocks, o_blocks) = dofs.upper_block_preallocation();
+            Mat::sbaij(world, dofs.n_owned_dofs, &d_blocks, &o_blocks)?
+        } else if pmg.is_some() {
+            let (d_nnz, o_nnz) = dofs.preallocation();
             Mat::baij(world, dofs.n_owned_dofs, 2, &d_nnz, &o_nnz)?
         } else {
+            let (d_nnz, o_nnz) = dofs.preallocation();
             Mat::aij(world, dofs.n_owned_dofs, dofs.block_size(), &d_nnz, &o_nnz)?
         };
         let linear = match &split {

@@ -245,9 +245,36 @@ impl DofMap {
         counts
     }
 
-    /// Exact nonzero counts per owned row in the diagonal and off-diagonal blocks, from the mesh
-    /// graph: every triangle around an owned node is on this rank.
-    pub fn preallocation(&self) -> (Vec<usize>, Vec<usize>) {
+    /// For a symmetric matrix stored by its upper triangle in node blocks (P2 displacements):
+    /// per owned node, the neighbour nodes (itself included) at or after it in the global
+    /// numbering, owned and on other ranks (which, numbered after this rank's, hold the rest
+    /// of the upper triangle).
+    pub fn upper_block_preallocation(&self) -> (Vec<usize>, Vec<usize>) {
+        let cols = self.node_neighbours();
+        let (mut d, mut o) = (Vec::new(), Vec::new());
+        for r in (0..self.n_nodes()).filter(|&r| self.node_owned[r]) {
+            let upper = cols[r]
+                .iter()
+                .filter(|&&n| self.node_global[n as usize] >= self.node_global[r]);
+            let (mut nd, mut no) = (0, 0);
+            for &n in upper {
+                if self.node_owned[n as usize] {
+                    nd += 1;
+                } else {
+                    no += 1;
+                }
+            }
+            d.push(nd);
+            o.push(no);
+        }
+        // Owned nodes come in the order of their dofs (see `owned_coordinates`), as the block
+        // rows do.
+        (d, o)
+    }
+
+    /// Per local node, the sorted nodes it shares a triangle with (itself included); empty for
+    /// nodes this rank does not own.
+    fn node_neighbours(&self) -> Vec<Vec<u32>> {
         let mut cols: Vec<Vec<u32>> = vec![Vec::new(); self.n_nodes()];
         for nodes in &self.tri_nodes {
             for &r in nodes {
@@ -256,14 +283,23 @@ impl DofMap {
                 }
             }
         }
+        for c in &mut cols {
+            c.sort_unstable();
+            c.dedup();
+        }
+        cols
+    }
+
+    /// Exact nonzero counts per owned row in the diagonal and off-diagonal blocks, from the mesh
+    /// graph: every triangle around an owned node is on this rank.
+    pub fn preallocation(&self) -> (Vec<usize>, Vec<usize>) {
+        let cols = self.node_neighbours();
         let mut d = vec![0; self.n_owned_dofs];
         let mut o = vec![0; self.n_owned_dofs];
-        for (r, c) in cols.iter_mut().enumerate() {
+        for (r, c) in cols.iter().enumerate() {
             if !self.node_owned[r] {
                 continue;
             }
-            c.sort_unstable();
-            c.dedup();
             let (mut nd, mut no) = (0, 0);
             for &n in c.iter() {
                 let k = self.ndof(n as usize);
