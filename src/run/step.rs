@@ -594,8 +594,8 @@ impl Simulation {
         let local = problem
             .local_values(x.as_ref())
             .map_err(|e| err(e.to_string()))?;
-        let elems = problem
-            .elements(&local)
+        let converged = problem
+            .converged(&local)
             .map_err(|e| SolveError::Fatal(format!("step {step}: {e}")))?;
         let driven = |n: usize| {
             dofs.node_points(n).iter().all(|&p| {
@@ -607,8 +607,8 @@ impl Simulation {
                 )
             })
         };
-        let reaction = problem.reaction(&elems, driven);
-        let set_reactions = self.set_reactions(mesh, dofs, &problem, &elems, from);
+        let reaction = problem.reaction(&converged, driven);
+        let set_reactions = self.set_reactions(mesh, dofs, &problem, &converged, from);
         let mut body_force = vec![[0.0; 2]; self.model.bodies.len()];
         let mut contact_state = super::contact::ContactState::new();
         for (c, f) in problem
@@ -629,7 +629,7 @@ impl Simulation {
         Ok(Outcome {
             du,
             pressure,
-            states: elems.into_iter().map(|e| e.states).collect(),
+            states: converged.states,
             reaction,
             set_reactions,
             body_force,
@@ -646,7 +646,7 @@ impl Simulation {
         mesh: &LocalMesh,
         dofs: &DofMap,
         problem: &StepProblem,
-        elems: &[crate::solve::problem::ElementResult],
+        converged: &crate::solve::problem::Converged,
         from: f64,
     ) -> Vec<[f64; 2]> {
         let scene = &self.model.scene;
@@ -661,7 +661,7 @@ impl Simulation {
                 if !named {
                     return [0.0; 2];
                 }
-                problem.reaction(elems, |n| {
+                problem.reaction(converged, |n| {
                     dofs.node_points(n).iter().all(|&p| {
                         let p = p as usize;
                         self.model.in_set(
