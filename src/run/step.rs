@@ -54,14 +54,23 @@ struct Split {
     pressure_mass: Mat,
 }
 
-/// Global dofs above which `solver.linear = "auto"` solves iteratively. Not a speed crossover:
-/// on the cantilever (bench/solver_scaling.sh, 1 rank, 2-core shared machine, OpenBLAS) the
-/// direct path took less CPU per Newton iteration at every size measured, 1.9x less at 21 k
-/// dofs (h = 1/16) and 2.4x less at 330 k dofs (h = 1/64), and the gap did not close. It is a
-/// memory limit: MUMPS held about 2.6 kB per dof (880 MB at 330 k dofs), against 1.9 kB for
-/// the iterative path (639 MB), so at 2 M dofs (about 250 k particles) the factorisation
-/// needs about 5 GB, and above that the iterative path keeps large runs in memory.
-const ITERATIVE_ABOVE_DOFS: usize = 2_000_000;
+/// Global dofs above which `solver.linear = "auto"` solves an elastic P2 system iteratively
+/// (the p-multigrid). A speed crossover, measured on one step of the 50-step cantilever
+/// (bench/VALIDATION.md, 2026-11-25): at 83 k dofs the two paths tie (1.61 against 1.56 s on 1
+/// rank, 1.19 against 1.16 s on 2), at 186 k the p-multigrid leads (3.3–3.5 against 3.9–4.1 s,
+/// 2.1–2.3 against 3.3–3.5 s) with less than half the memory, and at 333 k and 1.3 M dofs it
+/// leads on the large increments of the 5-step cantilever too (23.8–26.8 against 35.6 s and
+/// 101 against 158 s, 2 ranks).
+const ITERATIVE_ABOVE_DOFS: usize = 150_000;
+/// Whether `solver.linear = "auto"` solves iteratively: elastic P2 systems past
+/// [`ITERATIVE_ABOVE_DOFS`].
+fn auto_is_iterative(vertex_dofs: usize, plastic: bool, n_global_dofs: usize) -> bool {
+    vertex_dofs == 2 && !plastic && n_global_dofs > ITERATIVE_ABOVE_DOFS
+}
+
+/// Global dofs past which GAMG forms its Galerkin products all at once on several ranks
+/// (`prefer_lean_galerkin_products`): where memory, not time, bounds the run.
+const LEAN_PRODUCTS_ABOVE_DOFS: usize = 2_000_000;
 /// Relative tolerances of the iterative linear solves: tight enough that Newton's iterates, and
 /// so the histories, match the direct solver's (tests/iterative.rs: 1e-11 relative or closer).
 /// GMRES+GAMG on the cantilever (h = 1/8, 5 steps): 1e-6 kept the direct path's 35 Newton
@@ -309,8 +318,11 @@ impl Simulation {
             // The field split is left to an explicit choice: at yield its displacement block
             // loses the stiffness AMG needs (measured on block-compression, uniformly plastic
             // at step 1: GMRES did not converge in 1000 iterations with GAMG on that block).
+            // Nor does any AMG or p-multigrid hold a yielded P2 tangent: block-compression with
+            // `solver.element = "p2"` (h = 0.05, 2 ranks) stopped at step 2 with GMRES at its
+            // iteration limit with either, even with an exact coarse solve.
             LinearChoice::Auto => {
-                dofs.vertex_dofs == 2 && dofs.n_global_dofs > ITERATIVE_ABOVE_DOFS
+                auto_is_iterative(dofs.vertex_dofs, self.model.plastic(), dofs.n_global_dofs)
             }
         };
         let split = if iterative && dofs.vertex_dofs == 3 {
@@ -318,8 +330,7 @@ impl Simulation {
         } else {
             None
         };
-        // Past the size where `auto` turns iterative to save memory, memory keeps the lead.
-        if iterative && world.size() > 1 && dofs.n_global_dofs > ITERATIVE_ABOVE_DOFS {
+        if iterative && world.size() > 1 && dofs.n_global_dofs > LEAN_PRODUCTS_ABOVE_DOFS {
             crate::petsc::linear::prefer_lean_galerkin_products()?;
         }
         let pmg = if iterative && split.is_none() && p_multigrid_from_options()? {
@@ -877,4 +888,18 @@ fn fill_p_multigrid(
     // The matrix holds its own reference to the space.
     let space = NullSpace::new(world, m.space.n_owned, &modes).map_err(petsc)?;
     m.coarse.set_near_null_space(&space).map_err(petsc)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn auto_is_iterative_for_large_elastic_p2_systems_only() {
+        assert!(auto_is_iterative(2, false, 186_434));
+        assert!(!auto_is_iterative(2, false, 83_330));
+        // A yielded P2 tangent defeats the p-multigrid; P2–P1 defeats the field split.
+        assert!(!auto_is_iterative(2, true, 8_000_000));
+        assert!(!auto_is_iterative(3, false, 8_000_000));
+    }
 }
