@@ -510,22 +510,7 @@ fn the_p_multigrid_takes_fewer_krylov_iterations_than_gamg_on_2_ranks() {
     // this case (h = 1/32, one step of 50): 80 against 152 CG iterations (112 with the
     // start-of-step P1 stiffness as the coarse operator and one GAMG cycle).
     let dir = workdir("iterative-pmg-count");
-    ok(
-        &dir,
-        1,
-        &[
-            "new",
-            "cantilever",
-            "-o",
-            "c.h5",
-            "--set",
-            "mesh.h=0.03125",
-            "--set",
-            "steps.count=50",
-            "--set",
-            "solver.linear=\"iterative\"",
-        ],
-    );
+    common::cantilever_case(&dir, "0.03125", 50, &["solver.linear=\"iterative\""]);
     let count = |extra: &[&str]| {
         let mut args = vec!["c.h5", "--out", "o", "--until-step", "1", "--"];
         args.extend(extra);
@@ -549,22 +534,7 @@ fn the_coarse_operator_follows_the_tangent_through_a_large_rotation() {
     // 30 degrees. Measured here (h = 1/32, 2 ranks, step 1): 101 CG iterations in 8 Newton
     // iterations; with the start-of-step P1 stiffness as the coarse operator, 539.
     let dir = workdir("iterative-pmg-galerkin");
-    ok(
-        &dir,
-        1,
-        &[
-            "new",
-            "cantilever",
-            "-o",
-            "c.h5",
-            "--set",
-            "mesh.h=0.03125",
-            "--set",
-            "steps.count=5",
-            "--set",
-            "solver.linear=\"iterative\"",
-        ],
-    );
+    common::cantilever_case(&dir, "0.03125", 5, &["solver.linear=\"iterative\""]);
     let args = [
         "c.h5",
         "--out",
@@ -596,21 +566,7 @@ fn auto_turns_to_the_p_multigrid_where_it_is_faster() {
         ("0.0208333333333", 186_434, true),
     ] {
         let dir = workdir("iterative-auto");
-        let spacing = format!("mesh.h={h}");
-        ok(
-            &dir,
-            1,
-            &[
-                "new",
-                "cantilever",
-                "-o",
-                "c.h5",
-                "--set",
-                &spacing,
-                "--set",
-                "steps.count=50",
-            ],
-        );
+        common::cantilever_case(&dir, h, 50, &[]);
         let view = ok(&dir, 2, &["c.h5", "--until-step", "1", "--", "-ksp_view"]);
         let dof_count: usize = view
             .lines()

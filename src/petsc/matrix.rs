@@ -93,24 +93,13 @@ impl Mat {
                 })
                 .collect::<Result<Vec<Int>, _>>()
         };
-        let (d_nnz, o_nnz) = (blocks(d_nnz)?, blocks(o_nnz)?);
-        let bs = to_int(block, "block size")?;
-        let mat = Mat::create(comm, [n_local, n_local], "baij")?;
-        let raw = mat.raw;
-        // SAFETY: live handle; the block counts have n_local / block entries and are copied
-        // by PETSc.
-        unsafe {
-            check(
-                ffi::MatSeqBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr()),
-                "MatSeqBAIJSetPreallocation",
-            )?;
-            check(
-                ffi::MatMPIBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()),
-                "MatMPIBAIJSetPreallocation",
-            )?;
-            strict_assembly(raw)?;
-            Ok(mat)
-        }
+        Mat::blocked(
+            comm,
+            n_local,
+            block,
+            [blocks(d_nnz)?, blocks(o_nnz)?],
+            false,
+        )
     }
 
     /// Collective. MPISBAIJ (SeqSBAIJ on one rank), a symmetric matrix of which only the upper
@@ -142,30 +131,57 @@ impl Mat {
                 .map(|&k| to_int(k, "blocks per row"))
                 .collect::<Result<Vec<Int>, _>>()
         };
-        let (d_nnz, o_nnz) = (ints(d_blocks)?, ints(o_blocks)?);
-        let bs = to_int(BS, "block size")?;
-        let mat = Mat::create(comm, [n_local, n_local], "sbaij")?;
+        Mat::blocked(comm, n_local, BS, [ints(d_blocks)?, ints(o_blocks)?], true)
+    }
+
+    /// Collective. BAIJ, or SBAIJ (upper triangle only, the lower ignored on insertion) if
+    /// `symmetric`, with per block row `blocks[0]` blocks in owned columns and `blocks[1]` in
+    /// other ranks' columns.
+    fn blocked(
+        comm: &SimpleCommunicator,
+        n_local: usize,
+        block: usize,
+        blocks: [Vec<Int>; 2],
+        symmetric: bool,
+    ) -> Result<Mat, PetscError> {
+        let [d_nnz, o_nnz] = blocks;
+        let bs = to_int(block, "block size")?;
+        let kind = if symmetric { "sbaij" } else { "baij" };
+        let mat = Mat::create(comm, [n_local, n_local], kind)?;
         let raw = mat.raw;
-        // SAFETY: live handle; the block counts have n_local / 2 entries and are copied by
-        // PETSc.
+        // SAFETY: live handle; the block counts have n_local / block entries and are copied
+        // by PETSc.
         unsafe {
-            check(
-                ffi::MatSeqSBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr()),
-                "MatSeqSBAIJSetPreallocation",
-            )?;
-            check(
-                ffi::MatMPISBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()),
-                "MatMPISBAIJSetPreallocation",
-            )?;
+            if symmetric {
+                check(
+                    ffi::MatSeqSBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr()),
+                    "MatSeqSBAIJSetPreallocation",
+                )?;
+                check(
+                    ffi::MatMPISBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()),
+                    "MatMPISBAIJSetPreallocation",
+                )?;
+            } else {
+                check(
+                    ffi::MatSeqBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr()),
+                    "MatSeqBAIJSetPreallocation",
+                )?;
+                check(
+                    ffi::MatMPIBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()),
+                    "MatMPIBAIJSetPreallocation",
+                )?;
+            }
             strict_assembly(raw)?;
-            check(
-                ffi::MatSetOption(
-                    raw,
-                    ffi::MatOption_MAT_IGNORE_LOWER_TRIANGULAR,
-                    ffi::PetscBool_PETSC_TRUE,
-                ),
-                "MatSetOption(MAT_IGNORE_LOWER_TRIANGULAR)",
-            )?;
+            if symmetric {
+                check(
+                    ffi::MatSetOption(
+                        raw,
+                        ffi::MatOption_MAT_IGNORE_LOWER_TRIANGULAR,
+                        ffi::PetscBool_PETSC_TRUE,
+                    ),
+                    "MatSetOption(MAT_IGNORE_LOWER_TRIANGULAR)",
+                )?;
+            }
             Ok(mat)
         }
     }

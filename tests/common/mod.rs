@@ -97,17 +97,17 @@ pub fn history(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     (header, rows)
 }
 
-/// `pfem-mpi new cantilever -o c.h5` with h = 0.25 m (205 particles) and `steps` load steps, plus
-/// any further `--set key=value` overrides: the small case most run tests need.
-pub fn small_cantilever(dir: &Path, steps: u32, sets: &[&str]) {
-    let steps = format!("steps.count={steps}");
+/// `pfem-mpi new cantilever -o c.h5` with spacing `h` (m), `steps` load steps and any further
+/// `--set key=value` overrides.
+pub fn cantilever_case(dir: &Path, h: &str, steps: u32, sets: &[&str]) {
+    let (spacing, steps) = (format!("mesh.h={h}"), format!("steps.count={steps}"));
     let mut args = vec![
         "new",
         "cantilever",
         "-o",
         "c.h5",
         "--set",
-        "mesh.h=0.25",
+        &spacing,
         "--set",
         &steps,
     ];
@@ -115,4 +115,10 @@ pub fn small_cantilever(dir: &Path, steps: u32, sets: &[&str]) {
         args.extend(["--set", s]);
     }
     ok(dir, 1, &args);
+}
+
+/// `pfem-mpi new cantilever -o c.h5` with h = 0.25 m (205 particles) and `steps` load steps, plus
+/// any further `--set key=value` overrides: the small case most run tests need.
+pub fn small_cantilever(dir: &Path, steps: u32, sets: &[&str]) {
+    cantilever_case(dir, "0.25", steps, sets);
 }
