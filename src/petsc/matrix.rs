@@ -318,21 +318,7 @@ impl MatRef<'_> {
             rows.len() * cols.len(),
             "a dense block of values"
         );
-        // SAFETY: slices are valid for the stated lengths; PETSc copies the values.
-        check(
-            unsafe {
-                ffi::MatSetValues(
-                    self.raw,
-                    to_int(rows.len(), "rows")?,
-                    rows.as_ptr(),
-                    to_int(cols.len(), "columns")?,
-                    cols.as_ptr(),
-                    vals.as_ptr(),
-                    ffi::InsertMode_ADD_VALUES,
-                )
-            },
-            "MatSetValues",
-        )
+        self.add_with(ffi::MatSetValues, "MatSetValues", rows, cols, vals)
     }
 
     /// Adds a dense block `vals` (row-major, 2 rows.len() x 2 cols.len()) at the 2 × 2 blocks
@@ -349,10 +335,29 @@ impl MatRef<'_> {
             4 * rows.len() * cols.len(),
             "a dense block of 2 x 2 blocks"
         );
-        // SAFETY: slices are valid for the stated lengths; PETSc copies the values.
+        self.add_with(
+            ffi::MatSetValuesBlocked,
+            "MatSetValuesBlocked",
+            rows,
+            cols,
+            vals,
+        )
+    }
+
+    /// Adds `vals` at `rows` x `cols` through PETSc's point or blocked insertion `set`.
+    fn add_with(
+        &self,
+        set: SetValues,
+        name: &str,
+        rows: &[Int],
+        cols: &[Int],
+        vals: &[Scalar],
+    ) -> Result<(), PetscError> {
+        // SAFETY: the callers checked that `vals` holds the dense block `rows` x `cols` names;
+        // PETSc copies the values.
         check(
             unsafe {
-                ffi::MatSetValuesBlocked(
+                set(
                     self.raw,
                     to_int(rows.len(), "rows")?,
                     rows.as_ptr(),
@@ -362,7 +367,7 @@ impl MatRef<'_> {
                     ffi::InsertMode_ADD_VALUES,
                 )
             },
-            "MatSetValuesBlocked",
+            name,
         )
     }
 
@@ -381,6 +386,17 @@ impl MatRef<'_> {
         }
     }
 }
+
+/// PETSc's MatSetValues and MatSetValuesBlocked.
+type SetValues = unsafe extern "C" fn(
+    ffi::Mat,
+    Int,
+    *const Int,
+    Int,
+    *const Int,
+    *const Scalar,
+    ffi::InsertMode,
+) -> ffi::PetscErrorCode;
 
 /// A count or index as PETSc's integer, or an error when it does not fit (a 32-bit PETSc build
 /// and more than 2^31 unknowns).
