@@ -35,10 +35,11 @@ pub enum LinearSolver<'a> {
     /// displacements equal to 1e-15.
     Amg { rtol: Scalar, symmetric: bool },
     /// As [`LinearSolver::Amg`], preconditioned by a two-level p-multigrid instead of GAMG on
-    /// the P2 system: Chebyshev smoothing on P2, `interpolation` from P1 on the particles, and
-    /// one GAMG cycle on the rediscretised P1 stiffness `coarse` (which carries its own
-    /// rigid-body near-null space). GAMG then sets up on a quarter of the unknowns and on a
-    /// far sparser matrix, which is where GAMG on P2 spends its memory.
+    /// the P2 system: one Chebyshev–Jacobi sweep before and after on P2, `interpolation` from
+    /// P1 on the particles, and two GAMG cycles (Richardson) on `coarse`, the Galerkin product
+    /// of the element tangents that every Jacobian assembles (with its own rigid-body
+    /// near-null space). GAMG then sets up on a quarter of the unknowns and on a far sparser
+    /// matrix, which is where GAMG on P2 spends its memory.
     PMultigrid {
         rtol: Scalar,
         symmetric: bool,
@@ -125,9 +126,17 @@ fn real_option(name: &str, default: f64) -> Result<f64, PetscError> {
 /// Whether the iterative P2 path uses the two-level p-multigrid ([`LinearSolver::PMultigrid`]):
 /// yes unless the PETSc option `-pfem_pmg false` (or `0`) asks for GAMG on the P2 system, or
 /// the command line names its own preconditioner (`-pc_type`), which then replaces GAMG: the
-/// p-multigrid's tangent is BAIJ, which GAMG cannot coarsen.
+/// p-multigrid's tangent is BAIJ or SBAIJ, which GAMG cannot coarsen.
 pub fn p_multigrid_from_options() -> Result<bool, PetscError> {
     Ok(bool_option("-pfem_pmg", true)? && option_string("-pc_type")?.is_none())
+}
+
+/// Whether the p-multigrid's smoother works on a symmetric tangent stored by its upper
+/// triangle (SBAIJ): its default, point Jacobi, does; SOR and ILU, which a user may name with
+/// `-mg_levels_pc_type`, do not ("SSOR for block size > 1 is not yet implemented"), and get the
+/// whole tangent (BAIJ).
+pub fn upper_triangle_smoother_from_options() -> Result<bool, PetscError> {
+    Ok(option_string("-mg_levels_pc_type")?.is_none_or(|pc| pc == "jacobi"))
 }
 
 /// The PETSc option `name` as a boolean (`true`/`false`, `1`/`0`, ...), or `default`.

@@ -5,7 +5,7 @@ use super::{Simulation, StepReport};
 use crate::mapping::{recover_at_particles, TriStates};
 use crate::material::GaussState;
 use crate::mesh::LocalMesh;
-use crate::petsc::linear::p_multigrid_from_options;
+use crate::petsc::linear::{p_multigrid_from_options, upper_triangle_smoother_from_options};
 use crate::petsc::{
     IndexSet, LinearSolver, Mat, NullSpace, PVec, Petsc, PetscError, Snes, SolveFailure,
 };
@@ -38,8 +38,9 @@ impl SolverObjects {
     }
 }
 
-/// The coarse level of the two-level p-multigrid (iterative P2 path, `-pfem_pmg`): filled at
-/// every increment's start, as its geometry and constraints are the increment's.
+/// The coarse level of the two-level p-multigrid (iterative P2 path, `-pfem_pmg`): the
+/// interpolation and the near-null space are filled at every increment's start (its geometry
+/// and constraints), the coarse operator at every Jacobian (the tangent's Galerkin product).
 struct PMultigrid {
     space: CoarseSpace,
     interpolation: Mat,
@@ -362,16 +363,18 @@ impl Simulation {
         };
         // The p-multigrid only multiplies by the P2 tangent and reads its diagonal: blocks,
         // and only the upper triangle of a symmetric one.
-        let jac = if pmg.is_some() && self.symmetric_tangent() {
-            let (d_blocks, o_blocks) = dofs.upper_block_preallocation();
-            Mat::sbaij(world, dofs.n_owned_dofs, &d_blocks, &o_blocks)?
-        } else if pmg.is_some() {
-            let (d_nnz, o_nnz) = dofs.preallocation();
-            Mat::baij(world, dofs.n_owned_dofs, 2, &d_nnz, &o_nnz)?
-        } else {
-            let (d_nnz, o_nnz) = dofs.preallocation();
-            Mat::aij(world, dofs.n_owned_dofs, dofs.block_size(), &d_nnz, &o_nnz)?
-        };
+        let jac =
+            if pmg.is_some() && self.symmetric_tangent() && upper_triangle_smoother_from_options()?
+            {
+                let (d_blocks, o_blocks) = dofs.upper_block_preallocation();
+                Mat::sbaij(world, dofs.n_owned_dofs, &d_blocks, &o_blocks)?
+            } else if pmg.is_some() {
+                let (d_nnz, o_nnz) = dofs.preallocation();
+                Mat::baij(world, dofs.n_owned_dofs, 2, &d_nnz, &o_nnz)?
+            } else {
+                let (d_nnz, o_nnz) = dofs.preallocation();
+                Mat::aij(world, dofs.n_owned_dofs, dofs.block_size(), &d_nnz, &o_nnz)?
+            };
         let linear = match &split {
             Some(s) => LinearSolver::Schur {
                 rtol: SCHUR_RTOL,

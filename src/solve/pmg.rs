@@ -108,9 +108,10 @@ impl CoarseSpace {
     /// Hands `add` the Galerkin coarse operator Rᵀ K R of triangle `t` whose P2 tangent is `k`
     /// (row-major, 12 × 12, the element's dof order), R the triangle's own P1 → P2
     /// interpolation: the rows of its owned vertices as 2 × 2 blocks (global block rows, the
-    /// triangle's three global block columns, row-major values). Summed over the triangles this is exactly Pᵀ A P of the
-    /// assembled tangent A, since a midside node interpolates from the ends of its own edge,
-    /// so it has the sparsity of a P1 matrix and follows the tangent of every Newton iterate
+    /// triangle's three global block columns, row-major values). Summed over the triangles
+    /// this is exactly Pᵀ A P of the elements' part A of the tangent (contact and follower
+    /// pressures stay on the fine level), since a midside node interpolates from the ends of
+    /// its own edge, so it has the sparsity of a P1 matrix and follows the tangent of every Newton iterate
     /// (large rotations, yield). Prescribed P2 dofs take no part (zero rows of P), and rows
     /// and columns of prescribed coarse dofs are zero (their diagonal is the caller's).
     /// Returns the sum of the free diagonal entries added.

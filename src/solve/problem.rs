@@ -869,8 +869,8 @@ impl NonlinearProblem for StepProblem<'_> {
 impl StepProblem<'_> {
     /// Collective. Gives the prescribed coarse rows the mean free coarse diagonal (from this
     /// rank's sum of its free diagonal entries) and assembles the coarse operator. Contact and
-    /// follower pressures stay on the fine level: their terms sit on single nodes, which the
-    /// smoother reaches.
+    /// follower pressures stay on the fine level: their terms couple a node, or a boundary
+    /// edge's nodes, only, which the smoother reaches.
     fn finish_coarse_operator(
         &self,
         c: &CoarseOperator,
