@@ -41,12 +41,8 @@ impl Mat {
         let n_local = local[0];
         assert_eq!(d_nnz.len(), n_local, "one diagonal count per owned row");
         assert_eq!(o_nnz.len(), n_local, "one off-diagonal count per owned row");
-        let ints = |v: &[usize]| {
-            v.iter()
-                .map(|&c| to_int(c, "nonzeros per row"))
-                .collect::<Result<Vec<Int>, _>>()
-        };
-        let (d_nnz, o_nnz) = (ints(d_nnz)?, ints(o_nnz)?);
+        let d_nnz = to_ints(d_nnz, "nonzeros per row")?;
+        let o_nnz = to_ints(o_nnz, "nonzeros per row")?;
         let mat = Mat::create(comm, local, "aij")?;
         let raw = mat.raw;
         // SAFETY: live handle; the nnz arrays have n_local entries and are copied by PETSc.
@@ -126,12 +122,11 @@ impl Mat {
             n_local / BS,
             "one count per owned block row"
         );
-        let ints = |v: &[usize]| {
-            v.iter()
-                .map(|&k| to_int(k, "blocks per row"))
-                .collect::<Result<Vec<Int>, _>>()
-        };
-        Mat::blocked(comm, n_local, BS, [ints(d_blocks)?, ints(o_blocks)?], true)
+        let blocks = [
+            to_ints(d_blocks, "blocks per row")?,
+            to_ints(o_blocks, "blocks per row")?,
+        ];
+        Mat::blocked(comm, n_local, BS, blocks, true)
     }
 
     /// Collective. BAIJ, or SBAIJ (upper triangle only, the lower ignored on insertion) if
@@ -152,25 +147,22 @@ impl Mat {
         // SAFETY: live handle; the block counts have n_local / block entries and are copied
         // by PETSc.
         unsafe {
-            if symmetric {
-                check(
-                    ffi::MatSeqSBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr()),
-                    "MatSeqSBAIJSetPreallocation",
-                )?;
-                check(
-                    ffi::MatMPISBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()),
-                    "MatMPISBAIJSetPreallocation",
-                )?;
+            let (seq, mpi, names) = if symmetric {
+                (
+                    ffi::MatSeqSBAIJSetPreallocation as SeqPreallocation,
+                    ffi::MatMPISBAIJSetPreallocation as MpiPreallocation,
+                    ["MatSeqSBAIJSetPreallocation", "MatMPISBAIJSetPreallocation"],
+                )
             } else {
-                check(
-                    ffi::MatSeqBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr()),
-                    "MatSeqBAIJSetPreallocation",
-                )?;
-                check(
-                    ffi::MatMPIBAIJSetPreallocation(raw, bs, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()),
-                    "MatMPIBAIJSetPreallocation",
-                )?;
-            }
+                (
+                    ffi::MatSeqBAIJSetPreallocation as SeqPreallocation,
+                    ffi::MatMPIBAIJSetPreallocation as MpiPreallocation,
+                    ["MatSeqBAIJSetPreallocation", "MatMPIBAIJSetPreallocation"],
+                )
+            };
+            // Each applies only to its own matrix type (Seq on one rank, MPI on several).
+            check(seq(raw, bs, 0, d_nnz.as_ptr()), names[0])?;
+            check(mpi(raw, bs, 0, d_nnz.as_ptr(), 0, o_nnz.as_ptr()), names[1])?;
             strict_assembly(raw)?;
             if symmetric {
                 check(
@@ -387,6 +379,12 @@ impl MatRef<'_> {
     }
 }
 
+/// PETSc's Mat(Seq)(S)BAIJSetPreallocation: block size, default and per-row block counts.
+type SeqPreallocation = unsafe extern "C" fn(ffi::Mat, Int, Int, *const Int) -> ffi::PetscErrorCode;
+/// PETSc's MatMPI(S)BAIJSetPreallocation: block size, diagonal and off-diagonal block counts.
+type MpiPreallocation =
+    unsafe extern "C" fn(ffi::Mat, Int, Int, *const Int, Int, *const Int) -> ffi::PetscErrorCode;
+
 /// PETSc's MatSetValues and MatSetValuesBlocked.
 type SetValues = unsafe extern "C" fn(
     ffi::Mat,
@@ -397,6 +395,11 @@ type SetValues = unsafe extern "C" fn(
     *const Scalar,
     ffi::InsertMode,
 ) -> ffi::PetscErrorCode;
+
+/// Counts or indices as PETSc's integers (see [`to_int`]).
+pub fn to_ints(v: &[usize], what: &str) -> Result<Vec<Int>, PetscError> {
+    v.iter().map(|&k| to_int(k, what)).collect()
+}
 
 /// A count or index as PETSc's integer, or an error when it does not fit (a 32-bit PETSc build
 /// and more than 2^31 unknowns).

@@ -6,6 +6,7 @@ use crate::mapping::{recover_at_particles, TriStates};
 use crate::material::GaussState;
 use crate::mesh::LocalMesh;
 use crate::petsc::linear::{p_multigrid_from_options, upper_triangle_smoother_from_options};
+use crate::petsc::matrix::to_ints;
 use crate::petsc::{
     IndexSet, LinearSolver, Mat, NullSpace, PVec, Petsc, PetscError, Snes, SolveFailure,
 };
@@ -867,20 +868,17 @@ fn fill_p_multigrid(
     m: &PMultigrid,
 ) -> Result<(), String> {
     let petsc = |e: PetscError| e.to_string();
-    let to_int = |v: usize| crate::petsc::matrix::to_int(v, "dof").map_err(petsc);
-    let ints = |v: &[usize]| -> Result<Vec<crate::petsc::Int>, String> {
-        v.iter().map(|&g| to_int(g)).collect()
-    };
     let p = m.interpolation.as_ref();
     p.zero_entries().map_err(petsc)?;
     // Rank-local insertions; a failure on any rank is agreed on before the collective
     // assembly, so that no rank waits in it alone.
     let local = m.space.interpolation(dofs, setup.constraints, |r, c, w| {
-        p.add_values(&[to_int(r)?], &ints(c)?, w).map_err(petsc)
+        let row = to_ints(&[r], "dof")?;
+        p.add_values(&row, &to_ints(c, "dof")?, w)
     });
     let failed = sum_f64(world, &[if local.is_err() { 1.0 } else { 0.0 }])[0];
     match local {
-        Err(e) => return Err(e),
+        Err(e) => return Err(e.to_string()),
         Ok(()) if failed > 0.0 => {
             return Err("the p-multigrid's interpolation failed on another rank".into())
         }

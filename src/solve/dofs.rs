@@ -224,25 +224,15 @@ impl DofMap {
     /// vertices.
     pub fn vertex_neighbour_counts(&self) -> Vec<(usize, usize)> {
         let n_vertex = self.n_nodes() - self.edges.len();
-        let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n_vertex];
-        for nodes in &self.tri_nodes {
-            for &a in &nodes[..3] {
-                if self.node_owned[a as usize] {
-                    neighbours[a as usize].extend_from_slice(&nodes[..3]);
-                }
-            }
-        }
-        let mut counts = Vec::new();
-        for (a, nb) in neighbours.iter_mut().enumerate() {
-            if !self.node_owned[a] {
-                continue;
-            }
-            nb.sort_unstable();
-            nb.dedup();
-            let owned = nb.iter().filter(|&&b| self.node_owned[b as usize]).count();
-            counts.push((owned, nb.len() - owned));
-        }
-        counts
+        self.node_neighbours(3)[..n_vertex]
+            .iter()
+            .enumerate()
+            .filter(|&(a, _)| self.node_owned[a])
+            .map(|(_, nb)| {
+                let owned = nb.iter().filter(|&&b| self.node_owned[b as usize]).count();
+                (owned, nb.len() - owned)
+            })
+            .collect()
     }
 
     /// For a symmetric matrix stored by its upper triangle in node blocks (P2 displacements):
@@ -250,7 +240,7 @@ impl DofMap {
     /// numbering, owned and on other ranks (which, numbered after this rank's, hold the rest
     /// of the upper triangle).
     pub fn upper_block_preallocation(&self) -> (Vec<usize>, Vec<usize>) {
-        let cols = self.node_neighbours();
+        let cols = self.node_neighbours(6);
         let (mut d, mut o) = (Vec::new(), Vec::new());
         for r in (0..self.n_nodes()).filter(|&r| self.node_owned[r]) {
             let upper = cols[r]
@@ -272,11 +262,13 @@ impl DofMap {
         (d, o)
     }
 
-    /// Per local node, the sorted nodes it shares a triangle with (itself included); empty for
-    /// nodes this rank does not own.
-    fn node_neighbours(&self) -> Vec<Vec<u32>> {
+    /// Per local node, the sorted nodes it shares a triangle with (itself included), among each
+    /// triangle's first `first` nodes (3: the vertices, 6: all); empty for nodes this rank does
+    /// not own and for nodes past `first` in their triangles.
+    fn node_neighbours(&self, first: usize) -> Vec<Vec<u32>> {
         let mut cols: Vec<Vec<u32>> = vec![Vec::new(); self.n_nodes()];
         for nodes in &self.tri_nodes {
+            let nodes = &nodes[..first];
             for &r in nodes {
                 if self.node_owned[r as usize] {
                     cols[r as usize].extend_from_slice(nodes);
@@ -293,7 +285,7 @@ impl DofMap {
     /// Exact nonzero counts per owned row in the diagonal and off-diagonal blocks, from the mesh
     /// graph: every triangle around an owned node is on this rank.
     pub fn preallocation(&self) -> (Vec<usize>, Vec<usize>) {
-        let cols = self.node_neighbours();
+        let cols = self.node_neighbours(6);
         let mut d = vec![0; self.n_owned_dofs];
         let mut o = vec![0; self.n_owned_dofs];
         for (r, c) in cols.iter().enumerate() {

@@ -19,8 +19,8 @@ use pfem_partition::{allgather_u64, exscan_u64, Comm, PartitionError};
 pub struct CoarseSpace {
     /// Owned coarse dofs (2 per owned vertex node).
     pub n_owned: usize,
-    /// Per local node: the global number of its coarse x dof (y follows), `usize::MAX` for a
-    /// midside node.
+    /// Per local vertex node (the first nodes of the dof map): the global number of its coarse
+    /// x dof (y follows).
     coarse_dof: Vec<usize>,
     /// Per owned P2 row of the interpolation, nonzeros in owned and in other ranks' columns.
     pub interpolation_d_nnz: Vec<usize>,
@@ -43,11 +43,8 @@ impl CoarseSpace {
         let owned_vertices = (0..n_vertex).filter(|&n| dofs.node_owned[n]).count();
         let (coarse_first, _) = exscan_u64(comm, 2 * owned_vertices as u64);
         let table = allgather_u64(comm, &[dofs.first_dof as u64, coarse_first]);
-        let coarse_dof = (0..dofs.n_nodes())
+        let coarse_dof = (0..n_vertex)
             .map(|n| {
-                if n >= n_vertex {
-                    return usize::MAX;
-                }
                 let r = mesh.owner[dofs.node_point[n] as usize] as usize;
                 dofs.node_global[n] - table[2 * r] as usize + table[2 * r + 1] as usize
             })
@@ -111,17 +108,18 @@ impl CoarseSpace {
     /// triangle's three global block columns, row-major values). Summed over the triangles
     /// this is exactly Pᵀ A P of the elements' part A of the tangent (contact and follower
     /// pressures stay on the fine level), since a midside node interpolates from the ends of
-    /// its own edge, so it has the sparsity of a P1 matrix and follows the tangent of every Newton iterate
-    /// (large rotations, yield). Prescribed P2 dofs take no part (zero rows of P), and rows
-    /// and columns of prescribed coarse dofs are zero (their diagonal is the caller's).
-    /// Returns the sum of the free diagonal entries added.
+    /// its own edge: it has the sparsity of a P1 matrix and follows the tangent of every
+    /// Newton iterate (large rotations, yield). Prescribed P2 dofs take no part (zero rows of
+    /// P), and rows and columns of prescribed coarse dofs are zero (their diagonal is the
+    /// caller's). Returns the sum of the free diagonal entries added. On the assembly path:
+    /// nothing is allocated.
     pub fn galerkin_element<E>(
         &self,
         dofs: &DofMap,
         constraints: &Constraints,
         t: usize,
         k: &[f64],
-        mut add: impl FnMut(&[usize], &[usize], &[f64]) -> Result<(), E>,
+        add: impl FnOnce(&[usize], &[usize; 3], &[f64]) -> Result<(), E>,
     ) -> Result<f64, E> {
         let nodes = &dofs.tri_nodes[t];
         let v: [usize; 3] = std::array::from_fn(|a| nodes[a] as usize);
@@ -136,18 +134,20 @@ impl CoarseSpace {
         );
         // Coarse dofs come in (x, y) pairs at (2 b, 2 b + 1): whole 2 × 2 blocks.
         let blocks: [usize; 3] = std::array::from_fn(|a| self.coarse_dof[v[a]] / 2);
-        let (mut rows, mut vals) = (Vec::with_capacity(3), Vec::with_capacity(36));
-        let mut diagonal_sum = 0.0;
+        let (mut rows, mut vals) = ([0; 3], [0.0; 36]);
+        let (mut n_rows, mut diagonal_sum) = (0, 0.0);
         for a in (0..3).filter(|&a| dofs.node_owned[v[a]]) {
-            rows.push(blocks[a]);
-            for i in [2 * a, 2 * a + 1] {
-                vals.extend_from_slice(&coarse[i]);
+            rows[n_rows] = blocks[a];
+            for (r, i) in [2 * a, 2 * a + 1].into_iter().enumerate() {
+                let at = 12 * n_rows + 6 * r;
+                vals[at..at + 6].copy_from_slice(&coarse[i]);
                 if !fixed(v[a], i % 2) {
                     diagonal_sum += coarse[i][i];
                 }
             }
+            n_rows += 1;
         }
-        add(&rows, &blocks, &vals)?;
+        add(&rows[..n_rows], &blocks, &vals[..12 * n_rows])?;
         Ok(diagonal_sum)
     }
 
@@ -193,8 +193,9 @@ pub fn galerkin_product(
 ) -> [[f64; 6]; 6] {
     let n = N_DOFS;
     assert_eq!(k.len(), n * n, "a P2 triangle tangent");
-    // R as (fine dof, coarse dof, weight) triples.
-    let mut r: Vec<(usize, usize, f64)> = Vec::with_capacity(18);
+    // R as (fine dof, coarse dof, weight) triples: at most 6 vertex and 12 midside entries.
+    let mut r = [(0, 0, 0.0); 18];
+    let mut len = 0;
     for m in 0..6 {
         let ends: &[(usize, f64)] = if m < 3 {
             &[(m, 1.0)]
@@ -205,20 +206,22 @@ pub fn galerkin_product(
         for c in 0..2 {
             for &(a, w) in ends {
                 if free_fine[2 * m + c] && free_coarse[2 * a + c] {
-                    r.push((2 * m + c, 2 * a + c, w));
+                    r[len] = (2 * m + c, 2 * a + c, w);
+                    len += 1;
                 }
             }
         }
     }
+    let r = &r[..len];
     // K R, 12 × 6.
     let mut kr = [[0.0; 6]; N_DOFS];
-    for &(m, j, w) in &r {
+    for &(m, j, w) in r {
         for (i, row) in kr.iter_mut().enumerate() {
             row[j] += w * k[i * n + m];
         }
     }
     let mut coarse = [[0.0; 6]; 6];
-    for &(i, j, w) in &r {
+    for &(i, j, w) in r {
         for (cj, kij) in coarse[j].iter_mut().zip(kr[i].iter()) {
             *cj += w * kij;
         }

@@ -11,7 +11,7 @@ use crate::fem::p2::straight_sided;
 use crate::fem::surface_load::edge_pressure;
 use crate::material::{GaussState, Material};
 use crate::mesh::LocalMesh;
-use crate::petsc::matrix::{to_int, MatRef};
+use crate::petsc::matrix::{to_int, to_ints, MatRef};
 use crate::petsc::snes::{CallbackError, NonlinearProblem};
 use crate::petsc::{Int, Mat, PVec, PetscError, Scatter, VecRef};
 use crate::rigid::{pair_force, ContactPair, PairForce, Shape};
@@ -462,13 +462,7 @@ impl<'a> StepProblem<'a> {
                 }
             }
         }
-        let sums = pfem_partition::sum_f64(self.comm, &sums);
-        let mean = sums[0] / sums[1].max(1.0);
-        if mean.is_finite() && mean > 0.0 {
-            mean
-        } else {
-            1.0
-        }
+        positive_mean(self.comm, sums)
     }
 
     /// The diagonal of constrained rows, and the factor of their residual x − g.
@@ -686,6 +680,18 @@ impl StepProblem<'_> {
     }
 }
 
+/// Collective. The global mean of the diagonal entries whose rank-local sum and count are
+/// `sum_count`: the diagonal given to prescribed rows, or 1 where there is no positive one.
+fn positive_mean(comm: &Comm, sum_count: [f64; 2]) -> f64 {
+    let totals = pfem_partition::sum_f64(comm, &sum_count);
+    let mean = totals[0] / totals[1].max(1.0);
+    if mean.is_finite() && mean > 0.0 {
+        mean
+    } else {
+        1.0
+    }
+}
+
 impl NonlinearProblem for StepProblem<'_> {
     fn residual(&mut self, x: VecRef<'_>, f: VecRef<'_>) -> Result<(), CallbackError> {
         let first = self.dofs.first_dof;
@@ -737,20 +743,14 @@ impl NonlinearProblem for StepProblem<'_> {
 
     fn jacobian(&mut self, x: VecRef<'_>, j: MatRef<'_>) -> Result<(), CallbackError> {
         let fatal = |e: PetscError| CallbackError::Fatal(e.to_string());
-        let l2g = self
-            .dofs
-            .local_to_global()
-            .into_iter()
-            .map(|g| to_int(g, "dof"))
-            .collect::<Result<Vec<Int>, _>>()
-            .map_err(fatal)?;
+        let l2g = to_ints(&self.dofs.local_to_global(), "dof").map_err(fatal)?;
         j.zero_entries().map_err(fatal)?;
         if let Some(c) = &self.coarse {
             c.matrix.as_ref().zero_entries().map_err(fatal)?;
         }
         let mut coarse_diagonal = 0.0;
         // P2 displacements: every node carries x and y at consecutive global dofs (2 g, 2 g + 1).
-        let blocked = self.dofs_per_element == 12 && self.dofs.block_size() == 2;
+        let blocked = self.dofs.block_size() == 2;
         let mut block_cols = Vec::with_capacity(6);
         let mut rows = Vec::new();
         let mut vals = Vec::new();
@@ -766,12 +766,12 @@ impl NonlinearProblem for StepProblem<'_> {
                         t,
                         &e.tangent,
                         |rows, cols, vals| {
-                            let ints = |v: &[usize]| {
-                                v.iter()
-                                    .map(|&g| to_int(g, "coarse dof"))
-                                    .collect::<Result<Vec<Int>, _>>()
-                            };
-                            m.add_blocks(&ints(rows)?, &ints(cols)?, vals)
+                            let mut ints = [0 as Int; 6];
+                            for (i, &g) in rows.iter().chain(cols).enumerate() {
+                                ints[i] = to_int(g, "coarse dof")?;
+                            }
+                            let (rows, cols) = ints[..rows.len() + 3].split_at(rows.len());
+                            m.add_blocks(rows, cols, vals)
                         },
                     )
                     .map_err(fatal)?;
@@ -878,13 +878,7 @@ impl StepProblem<'_> {
     ) -> Result<(), PetscError> {
         let constraints = self.setup.constraints;
         let count = c.space.free_count(self.dofs, constraints) as f64;
-        let totals = pfem_partition::sum_f64(self.comm, &[diagonal_sum, count]);
-        let mean = totals[0] / totals[1].max(1.0);
-        let diagonal = if mean.is_finite() && mean > 0.0 {
-            mean
-        } else {
-            1.0
-        };
+        let diagonal = positive_mean(self.comm, [diagonal_sum, count]);
         let m = c.matrix.as_ref();
         for r in c.space.fixed_rows(self.dofs, constraints) {
             let r = to_int(r, "coarse dof")?;
