@@ -340,20 +340,11 @@ impl Simulation {
                 code: -1,
                 message: e.to_string(),
             })?;
-            let interpolation = Mat::aij_rect(
-                world,
-                [dofs.n_owned_dofs, space.n_owned],
-                2,
-                &space.interpolation_d_nnz,
-                &space.interpolation_o_nnz,
-            )?;
-            let coarse = Mat::aij(
-                world,
-                space.n_owned,
-                2,
-                &space.operator_d_nnz,
-                &space.operator_o_nnz,
-            )?;
+            let (d_nnz, o_nnz) = space.interpolation_preallocation(dofs);
+            let interpolation =
+                Mat::aij_rect(world, [dofs.n_owned_dofs, space.n_owned], 2, &d_nnz, &o_nnz)?;
+            let (d_nnz, o_nnz) = CoarseSpace::operator_preallocation(dofs);
+            let coarse = Mat::aij(world, space.n_owned, 2, &d_nnz, &o_nnz)?;
             Some(PMultigrid {
                 space,
                 interpolation,

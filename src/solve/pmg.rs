@@ -22,12 +22,6 @@ pub struct CoarseSpace {
     /// Per local vertex node (the first nodes of the dof map): the global number of its coarse
     /// x dof (y follows).
     coarse_dof: Vec<usize>,
-    /// Per owned P2 row of the interpolation, nonzeros in owned and in other ranks' columns.
-    pub interpolation_d_nnz: Vec<usize>,
-    pub interpolation_o_nnz: Vec<usize>,
-    /// Per owned coarse row of the coarse operator, nonzeros in owned and in other ranks' columns.
-    pub operator_d_nnz: Vec<usize>,
-    pub operator_o_nnz: Vec<usize>,
 }
 
 impl CoarseSpace {
@@ -49,31 +43,40 @@ impl CoarseSpace {
                 dofs.node_global[n] - table[2 * r] as usize + table[2 * r + 1] as usize
             })
             .collect();
-        let (mut interpolation_d_nnz, mut interpolation_o_nnz) = (Vec::new(), Vec::new());
+        Ok(CoarseSpace {
+            n_owned: 2 * owned_vertices,
+            coarse_dof,
+        })
+    }
+
+    /// Per owned P2 row of the interpolation, its nonzeros in owned and in other ranks'
+    /// columns. Made on demand and dropped once the matrix is preallocated: kept, the counts of
+    /// both matrices would sit under the memory peak of every Newton iteration.
+    pub fn interpolation_preallocation(&self, dofs: &DofMap) -> (Vec<usize>, Vec<usize>) {
+        let (mut d_nnz, mut o_nnz) = (Vec::new(), Vec::new());
         for n in (0..dofs.n_nodes()).filter(|&n| dofs.node_owned[n]) {
             let ends = interpolation_ends(dofs, n);
             let inside = ends.iter().filter(|&&(v, _)| dofs.node_owned[v]).count();
             // One entry per end: a component interpolates from the same component.
             for _ in 0..2 {
-                interpolation_d_nnz.push(inside);
-                interpolation_o_nnz.push(ends.len() - inside);
+                d_nnz.push(inside);
+                o_nnz.push(ends.len() - inside);
             }
         }
-        let (mut operator_d_nnz, mut operator_o_nnz) = (Vec::new(), Vec::new());
+        (d_nnz, o_nnz)
+    }
+
+    /// Per owned coarse row of the coarse operator, its nonzeros in owned and in other ranks'
+    /// columns (made on demand, as [`Self::interpolation_preallocation`]).
+    pub fn operator_preallocation(dofs: &DofMap) -> (Vec<usize>, Vec<usize>) {
+        let (mut d_nnz, mut o_nnz) = (Vec::new(), Vec::new());
         for (owned, other) in dofs.vertex_neighbour_counts() {
             for _ in 0..2 {
-                operator_d_nnz.push(2 * owned);
-                operator_o_nnz.push(2 * other);
+                d_nnz.push(2 * owned);
+                o_nnz.push(2 * other);
             }
         }
-        Ok(CoarseSpace {
-            n_owned: 2 * owned_vertices,
-            coarse_dof,
-            interpolation_d_nnz,
-            interpolation_o_nnz,
-            operator_d_nnz,
-            operator_o_nnz,
-        })
+        (d_nnz, o_nnz)
     }
 
     /// Hands `add` the interpolation's entries on this rank's P2 rows, one row at a time
@@ -87,7 +90,7 @@ impl CoarseSpace {
         constraints: &Constraints,
         mut add: impl FnMut(usize, &[usize], &[f64]) -> Result<(), E>,
     ) -> Result<(), E> {
-        let fixed = |n: usize, c: usize| constraints.fixed[n][c].is_some();
+        let fixed = |n: usize, c: usize| constraints.is_fixed(n, c);
         for n in (0..dofs.n_nodes()).filter(|&n| dofs.node_owned[n]) {
             let ends = interpolation_ends(dofs, n);
             for c in 0..2 {
@@ -126,7 +129,7 @@ impl CoarseSpace {
         if v.iter().all(|&n| !dofs.node_owned[n]) {
             return Ok(0.0);
         }
-        let fixed = |n: usize, c: usize| constraints.fixed[n][c].is_some();
+        let fixed = |n: usize, c: usize| constraints.is_fixed(n, c);
         let coarse = galerkin_product(
             k,
             std::array::from_fn(|d| !fixed(nodes[d / 2] as usize, d % 2)),
@@ -155,11 +158,7 @@ impl CoarseSpace {
     pub fn free_count(&self, dofs: &DofMap, constraints: &Constraints) -> usize {
         (0..n_vertex_nodes(dofs))
             .filter(|&n| dofs.node_owned[n])
-            .map(|n| {
-                (0..2)
-                    .filter(|&c| constraints.fixed[n][c].is_none())
-                    .count()
-            })
+            .map(|n| (0..2).filter(|&c| !constraints.is_fixed(n, c)).count())
             .sum()
     }
 
@@ -168,7 +167,7 @@ impl CoarseSpace {
         (0..n_vertex_nodes(dofs))
             .filter(|&n| dofs.node_owned[n])
             .flat_map(|n| (0..2).map(move |c| (n, c)))
-            .filter(|&(n, c)| constraints.fixed[n][c].is_some())
+            .filter(|&(n, c)| constraints.is_fixed(n, c))
             .map(|(n, c)| self.coarse_dof[n] + c)
             .collect()
     }

@@ -11,7 +11,7 @@ use crate::fem::p2::straight_sided;
 use crate::fem::surface_load::edge_pressure;
 use crate::material::{GaussState, Material};
 use crate::mesh::LocalMesh;
-use crate::petsc::matrix::{to_int, to_ints, MatRef};
+use crate::petsc::matrix::{to_int, MatRef};
 use crate::petsc::snes::{CallbackError, NonlinearProblem};
 use crate::petsc::{Int, Mat, PVec, PetscError, Scatter, VecRef};
 use crate::rigid::{pair_force, ContactPair, PairForce, Shape};
@@ -239,8 +239,7 @@ impl<'a> StepProblem<'a> {
                 let g = self.dofs.node_global[n] - first;
                 let guess = predictor(n);
                 for c in 0..self.dofs.ndof(n) {
-                    xa[g + c] = match (c, self.setup.constraints.fixed[n].get(c).copied().flatten())
-                    {
+                    xa[g + c] = match (c, self.setup.constraints.value(n, c)) {
                         (2, _) => guess[2] / scale,
                         (_, Some(v)) => v,
                         _ => guess[c],
@@ -288,7 +287,7 @@ impl<'a> StepProblem<'a> {
         let reacting = |t: usize| {
             (0..12).any(|k| {
                 let node = self.dofs.tri_nodes[t][k / 2] as usize;
-                self.dofs.node_owned[node] && self.setup.constraints.fixed[node][k % 2].is_some()
+                self.dofs.node_owned[node] && self.setup.constraints.is_fixed(node, k % 2)
             })
         };
         let mut out = Converged {
@@ -474,7 +473,7 @@ impl<'a> StepProblem<'a> {
     fn constrained_column(&self, t: usize, k: usize) -> bool {
         k < 12 && {
             let node = self.dofs.tri_nodes[t][k / 2] as usize;
-            self.setup.constraints.fixed[node][k % 2].is_some()
+            self.setup.constraints.is_fixed(node, k % 2)
         }
     }
 
@@ -483,8 +482,7 @@ impl<'a> StepProblem<'a> {
     fn free_row(&self, t: usize, k: usize) -> Option<usize> {
         let node = self.dofs.tri_nodes[t][if k < 12 { k / 2 } else { k - 12 }] as usize;
         let c = if k < 12 { k % 2 } else { 2 };
-        if !self.dofs.node_owned[node] || (c < 2 && self.setup.constraints.fixed[node][c].is_some())
-        {
+        if !self.dofs.node_owned[node] || (c < 2 && self.setup.constraints.is_fixed(node, c)) {
             return None;
         }
         Some(self.dofs.node_global[node] - self.dofs.first_dof + c)
@@ -609,7 +607,7 @@ impl<'a> StepProblem<'a> {
 
     /// Whether component `c` of local node `n` is an owned, unconstrained row.
     fn free(&self, n: usize, c: usize) -> bool {
-        self.dofs.node_owned[n] && self.setup.constraints.fixed[n][c].is_none()
+        self.dofs.node_owned[n] && !self.setup.constraints.is_fixed(n, c)
     }
 
     /// Reaction forces: the internal force on the constrained owned dofs of the nodes `select`
@@ -621,7 +619,7 @@ impl<'a> StepProblem<'a> {
                 let node = self.dofs.tri_nodes[*t][k / 2] as usize;
                 let c = k % 2;
                 if self.dofs.node_owned[node]
-                    && self.setup.constraints.fixed[node][c].is_some()
+                    && self.setup.constraints.is_fixed(node, c)
                     && select(node)
                 {
                     r[c] += f;
@@ -643,7 +641,7 @@ impl StepProblem<'_> {
         let g = |n: usize, c: usize| to_int(self.dofs.node_global[n] + c, "dof");
         // A prescribed column adds an explicit zero: the matrix keeps one pattern, and the
         // constrained rows and columns stay symmetric.
-        let fixed = |n: usize, k: usize| self.setup.constraints.fixed[n][k].is_some();
+        let fixed = |n: usize, k: usize| self.setup.constraints.is_fixed(n, k);
         for (c, f) in self.setup.contact.iter().zip(self.contact_forces(local)) {
             let n = c.node as usize;
             for i in 0..2 {
@@ -720,20 +718,15 @@ impl NonlinearProblem for StepProblem<'_> {
             for &(n, force) in &self.setup.point_loads {
                 let n = n as usize;
                 for (c, fc) in force.iter().enumerate() {
-                    if self.setup.constraints.fixed[n][c].is_none() {
+                    if !self.setup.constraints.is_fixed(n, c) {
                         fa[self.dofs.node_global[n] - first + c] -= fc;
                     }
                 }
             }
-            for (n, fx) in self.setup.constraints.fixed.iter().enumerate() {
-                if !self.dofs.node_owned[n] {
-                    continue;
-                }
-                for (c, g) in fx.iter().enumerate() {
-                    if let Some(g) = g {
-                        fa[self.dofs.node_global[n] - first + c] =
-                            diagonal * (local[self.dofs.node_local[n] + c] - g);
-                    }
+            for (n, c, g) in self.setup.constraints.prescribed() {
+                if self.dofs.node_owned[n] {
+                    fa[self.dofs.node_global[n] - first + c] =
+                        diagonal * (local[self.dofs.node_local[n] + c] - g);
                 }
             }
         })
@@ -743,7 +736,6 @@ impl NonlinearProblem for StepProblem<'_> {
 
     fn jacobian(&mut self, x: VecRef<'_>, j: MatRef<'_>) -> Result<(), CallbackError> {
         let fatal = |e: PetscError| CallbackError::Fatal(e.to_string());
-        let l2g = to_ints(&self.dofs.local_to_global(), "dof").map_err(fatal)?;
         j.zero_entries().map_err(fatal)?;
         if let Some(c) = &self.coarse {
             c.matrix.as_ref().zero_entries().map_err(fatal)?;
@@ -843,15 +835,10 @@ impl NonlinearProblem for StepProblem<'_> {
         self.external_tangent(&local, |r, c, v| j.add_values(&[r], &[c], &[v]))
             .map_err(fatal)?;
         let diagonal = self.constrained_diagonal();
-        for (n, fx) in self.setup.constraints.fixed.iter().enumerate() {
-            if !self.dofs.node_owned[n] {
-                continue;
-            }
-            for (c, g) in fx.iter().enumerate() {
-                if g.is_some() {
-                    let r = l2g[self.dofs.node_local[n] + c];
-                    j.add_values(&[r], &[r], &[diagonal]).map_err(fatal)?;
-                }
+        for (n, c, _) in self.setup.constraints.prescribed() {
+            if self.dofs.node_owned[n] {
+                let r = to_int(self.dofs.node_global[n] + c, "dof").map_err(fatal)?;
+                j.add_values(&[r], &[r], &[diagonal]).map_err(fatal)?;
             }
         }
         if let Some(schur) = &self.schur {
