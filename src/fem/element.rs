@@ -153,6 +153,29 @@ pub fn p2_element(
     mat: &dyn Material,
     body_force: [f64; 2],
 ) -> Result<ElementOutput, ElementError> {
+    p2_element_with(x, du, states_n, mat, body_force, true)
+}
+
+/// [`p2_element`] without the tangent (left zero): the residual evaluations of Newton's line
+/// search and of the converged state read no tangent, and forming it was most of their cost.
+pub fn p2_residual(
+    x: &[[f64; 2]; N_NODES],
+    du: &[[f64; 2]; N_NODES],
+    states_n: &[GaussState; N_GAUSS],
+    mat: &dyn Material,
+    body_force: [f64; 2],
+) -> Result<ElementOutput, ElementError> {
+    p2_element_with(x, du, states_n, mat, body_force, false)
+}
+
+fn p2_element_with(
+    x: &[[f64; 2]; N_NODES],
+    du: &[[f64; 2]; N_NODES],
+    states_n: &[GaussState; N_GAUSS],
+    mat: &dyn Material,
+    body_force: [f64; 2],
+    with_tangent: bool,
+) -> Result<ElementOutput, ElementError> {
     let mut residual = [0.0; N_DOFS];
     let mut tangent = [[0.0; N_DOFS]; N_DOFS];
     let mut states = *states_n;
@@ -190,6 +213,21 @@ pub fn p2_element(
             }
         }
 
+        let n = p2::shape(xi);
+        for k in 0..N_DOFS {
+            let mut fk = 0.0;
+            for (bi, si) in b.iter().zip(s.iter()) {
+                fk += bi[k] * si;
+            }
+            residual[k] += w * (fk - n[k / 2] * body_force[k % 2]);
+        }
+        let mut st = resp.state;
+        st.stress = push_forward(&f, &s, j);
+        states[q] = st;
+        if !with_tangent {
+            continue;
+        }
+
         // Weighted D·B, so the material stiffness below is a plain Bᵀ·(wDB) product.
         let mut db = [[0.0; N_DOFS]; 4];
         for (dbi, di) in db.iter_mut().zip(d.iter()) {
@@ -203,15 +241,7 @@ pub fn p2_element(
             }
         }
 
-        let n = p2::shape(xi);
-        for k in 0..N_DOFS {
-            let mut fk = 0.0;
-            for (bi, si) in b.iter().zip(s.iter()) {
-                fk += bi[k] * si;
-            }
-            residual[k] += w * (fk - n[k / 2] * body_force[k % 2]);
-
-            let row = &mut tangent[k];
+        for (k, row) in tangent.iter_mut().enumerate() {
             for (bi, dbi) in b.iter().zip(db.iter()) {
                 let bik = bi[k];
                 if bik != 0.0 {
@@ -231,10 +261,6 @@ pub fn p2_element(
                 tangent[2 * a + 1][2 * bn + 1] += kg;
             }
         }
-
-        let mut st = resp.state;
-        st.stress = push_forward(&f, &s, j);
-        states[q] = st;
     }
 
     Ok(ElementOutput {
@@ -316,6 +342,20 @@ mod tests {
         a.iter()
             .zip(b.iter())
             .all(|(x, y)| (x - y).abs() <= tol * scale)
+    }
+
+    #[test]
+    fn the_residual_alone_is_the_full_elements_bit_for_bit() {
+        let x = curved_element();
+        let f = mul(&rot(0.6), &[[1.25, 0.1], [0.1, 0.85]]);
+        let du = homogeneous_du(&x, &f, [0.5, 0.2]);
+        let body = [0.5e3, -2.0e4];
+        let full = p2_element(&x, &du, &prestress(), &elastic(), body).expect("valid element");
+        let lean = p2_residual(&x, &du, &prestress(), &elastic(), body).expect("valid element");
+        assert_eq!(full.residual.map(f64::to_bits), lean.residual.map(f64::to_bits));
+        assert_eq!(format!("{:?}", full.states), format!("{:?}", lean.states));
+        assert!(lean.tangent.iter().flatten().all(|&k| k == 0.0));
+        assert!(full.tangent.iter().flatten().any(|&k| k != 0.0));
     }
 
     #[test]

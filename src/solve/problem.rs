@@ -5,7 +5,7 @@
 
 use super::pmg::CoarseSpace;
 use super::{Constraints, DofMap};
-use crate::fem::element::p2_element;
+use crate::fem::element::{p2_element, p2_residual};
 use crate::fem::mixed::p2p1_element;
 use crate::fem::p2::straight_sided;
 use crate::fem::surface_load::edge_pressure;
@@ -338,35 +338,38 @@ impl<'a> StepProblem<'a> {
         let du: [[f64; 2]; 6] = std::array::from_fn(|k| [at(2 * k), at(2 * k + 1)]);
         let geometry = self.geometry(t);
         let flat = |k: &[f64]| if tangent { k.to_vec() } else { Vec::new() };
-        let result =
-            match s.kernel {
-                Kernel::P2 => p2_element(&geometry, &du, &s.states_n[t], s.material, s.body_force)
-                    .map(|e| ElementResult {
+        let result = match s.kernel {
+            Kernel::P2 => {
+                let element = if tangent { p2_element } else { p2_residual };
+                element(&geometry, &du, &s.states_n[t], s.material, s.body_force).map(|e| {
+                    ElementResult {
                         residual: e.residual.to_vec(),
                         tangent: flat(e.tangent.as_flattened()),
                         states: e.states,
-                    }),
-                Kernel::P2P1 { bulk, scale } => {
-                    let p: [f64; 3] = std::array::from_fn(|k| scale * at(12 + k));
-                    p2p1_element(
-                        &geometry,
-                        &du,
-                        &p,
-                        &s.states_n[t],
-                        s.material,
-                        bulk,
-                        s.body_force,
-                    )
-                    .map(|e| {
-                        let e = e.with_pressure_scale(scale);
-                        ElementResult {
-                            residual: e.residual.to_vec(),
-                            tangent: flat(e.tangent.as_flattened()),
-                            states: e.states,
-                        }
-                    })
-                }
-            };
+                    }
+                })
+            }
+            Kernel::P2P1 { bulk, scale } => {
+                let p: [f64; 3] = std::array::from_fn(|k| scale * at(12 + k));
+                p2p1_element(
+                    &geometry,
+                    &du,
+                    &p,
+                    &s.states_n[t],
+                    s.material,
+                    bulk,
+                    s.body_force,
+                )
+                .map(|e| {
+                    let e = e.with_pressure_scale(scale);
+                    ElementResult {
+                        residual: e.residual.to_vec(),
+                        tangent: flat(e.tangent.as_flattened()),
+                        states: e.states,
+                    }
+                })
+            }
+        };
         result.map_err(|e| format!("triangle {:?}: {e}", self.mesh.tri_key(t)))
     }
 
