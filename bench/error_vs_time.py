@@ -5,6 +5,7 @@ by, and the per-scene table (Markdown) and error-against-time plot (PNG).
   error_vs_time.py mesh SCENE FACTOR      --set arguments (one a line) for the spacing FACTOR
   error_vs_time.py push SCENE STEPS       --set arguments (one a line) for STEPS steps
   error_vs_time.py record CSV KEY=VALUE.. measure one finished run and merge its row into CSV
+  error_vs_time.py measure SCENE HISTORY  print one run's figure and error (bench/adapt_study.sh)
   error_vs_time.py report SCENE CSV OUT   write OUT.md and OUT.png from CSV
   error_vs_time.py iterative-failed CSV RANKS   exit 0 if the iterative path failed on RANKS
 
@@ -466,7 +467,7 @@ def main():
     elif cmd == "push":
         print("\n".join(push_sets(sys.argv[2], int(sys.argv[3]))))
     elif cmd == "measure":
-        # One run's figure and error from its history (bench/adapt_footing.sh).
+        # One run's figure and error from its history (bench/adapt_study.sh: footing, tbar-smooth).
         value, value2, err, note = measure(sys.argv[2], history(sys.argv[3]))
         text = f"value {value} error {'-' if err is None else f'{100 * err:.3g} %'}"
         if sys.argv[2] == "footing":

@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# Run time against error with `[mesh.adapt]` (issue 10, item 5, last sentence) for SCENE
+# (`footing` or `tbar-smooth`): one run of the scene's short push (bench/error_vs_time.py `push`:
+# the footing's 2 m, z/B = 1; the T-bar's 0.25D) with the spacing factor FACTOR applied to
+# `mesh.h` and the `mesh.fine` regions (bench/error_vs_time.py `mesh`), STEPS steps, RANKS ranks,
+# the direct solver, and the `[mesh.adapt]` table ADAPT (empty: no adaptation), measured as
+# bench/error_vs_time.sh measures (`nice -n 19`, unbound `mpirun`, `/usr/bin/time` around each
+# rank, CPU s summed over the ranks) and judged by bench/error_vs_time.py `measure`:
+#   footing      the q/cu curve against the h/2 curve at z/B = 0.25-1, and the worst step from
+#                z/B = 0.25 on
+#   tbar-smooth  |mean Nc / 9.142 - 1| over the steps with w >= 0.1D
+# Appends a row to bench/results/SCENE-adapt.csv and the invocation to
+# bench/results/SCENE-adapt.commands. A run that fails or is cut by TIMEOUT (s of wall) gets a
+# row too, with its exit code, the last step it reached, the solver's first error line and the
+# figure measured so far (no error: it did not compute what was asked).
+#
+# EXTRA: further `--set` overrides, separated by ';' (applied last), e.g. EXTRA='mesh.fine=[]'.
+# BIN / BENCH_WORK: a prebuilt binary instead of `cargo build`, and where the work folders go
+# (bench/setup.sh).
+#
+# Usage: FACTOR=2 STEPS=100 RANKS=1 ADAPT='{h_min=0.125,h_max=1.0}' bench/adapt_study.sh footing
+#        FACTOR=2 STEPS=10 ADAPT='{h_min=0.005,h_max=0.04}' BIN=/path/pfem-mpi bench/adapt_study.sh tbar-smooth
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$PWD
+scene=${1:?usage: bench/adapt_study.sh footing|tbar-smooth}
+case $scene in
+  footing) default_steps=100 default_timeout=3000 ;;
+  tbar-smooth) default_steps=10 default_timeout=900 ;;
+  *) echo "adapt_study.sh: unknown scene $scene (footing or tbar-smooth)" >&2 && exit 2 ;;
+esac
+helper=$root/bench/error_vs_time.py
+factor=${FACTOR:-1}
+steps=${STEPS:-$default_steps}
+ranks=${RANKS:-1}
+adapt=${ADAPT:-}
+extra=${EXTRA:-}
+timeout=${TIMEOUT:-$default_timeout}
+csv=$root/bench/results/$scene-adapt.csv
+echo "FACTOR=$factor STEPS=$steps RANKS=$ranks ADAPT='$adapt'${extra:+ EXTRA='$extra'} TIMEOUT=$timeout bench/adapt_study.sh $scene" \
+  >>"$root/bench/results/$scene-adapt.commands"
+# One work folder per setting (a short hash of ADAPT and EXTRA keeps different settings apart).
+tag=$(printf '%s|%s' "$adapt" "$extra" | md5sum | cut -c1-6)
+source bench/setup.sh "adapt_${scene}_f${factor}_n${steps}_r${ranks}${adapt:+_adapt}${extra:+_extra}_$tag"
+mapfile -t mesh < <(python3 "$helper" mesh "$scene" "$factor")
+mapfile -t push < <(python3 "$helper" push "$scene" "$steps")
+sets=(--set 'solver.linear="direct"')
+for s in "${mesh[@]}" "${push[@]}"; do sets+=(--set "$s"); done
+[[ -z $adapt ]] || sets+=(--set "mesh.adapt=$adapt")
+IFS=';' read -ra more <<<"$extra"
+for s in "${more[@]}"; do sets+=(--set "$s"); done
+"$bin" new "$scene" -o case.h5 "${sets[@]}" >new.log
+particles=$("$bin" info case.h5 | awk '/^particles/ {print $2}')
+code=0
+SECONDS=0
+nice -n 19 timeout -k 30 "$timeout" mpirun --bind-to none -n "$ranks" sh -c \
+  'exec /usr/bin/time -f "%U %S %M" -o "run.time.$OMPI_COMM_WORLD_RANK" "$@"' run \
+  "$bin" case.h5 --out run.out >run.log 2>&1 || code=$?
+wall=$SECONDS
+# Empty when a rank was killed before /usr/bin/time wrote its line.
+cpu=$( (cat run.time.* 2>/dev/null || true) | awk '$1 ~ /^[0-9.]+$/ { c += $1 + $2; n++ } END { if (n) printf "%.2f", c }')
+done_line=$(grep -m1 '^done:' run.log || true)
+newton=$(grep -o '[0-9]* Newton iterations' <<<"$done_line" | cut -d' ' -f1 || true)
+last_particles=$(grep '^step' run.log | tail -1 | grep -o 'particles [0-9]*' | cut -d' ' -f2 || true)
+cuts=$(grep -c 'cut [0-9]*x' run.log || true)
+last=$(tail -1 run.out/history.csv 2>/dev/null | cut -d, -f1 || true)
+[[ $last != step ]] || last=''  # the header alone: no step finished
+if ((code == 0)) && [[ $last == "$steps" ]]; then
+  result=$(python3 "$helper" measure "$scene" run.out/history.csv)
+else
+  if ((code == 124 || code == 137)); then
+    result="timeout after $wall s (last step ${last:-none})"
+  else
+    result="failed (exit $code, last step ${last:-none}): $(grep -m1 -i -E 'error|did not|panick' run.log | cut -c1-300)"
+  fi
+  if [[ -n $last ]]; then
+    result+="; so far: $(python3 "$helper" measure "$scene" run.out/history.csv 2>/dev/null |
+      sed 's/ error [^(]*(/ (/' || echo 'not measured')"
+  fi
+fi
+result=${result//\"/\'}
+[[ -f $csv ]] || echo "factor,steps,ranks,adapt,particles_start,particles_end,cpu_s,newton_its,steps_cut,result" >"$csv"
+settings=$adapt${adapt:+${extra:+ }}$extra
+echo "$factor,$steps,$ranks,\"$settings\",$particles,$last_particles,$cpu,$newton,$cuts,\"$result\"" | tee -a "$csv"
