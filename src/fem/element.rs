@@ -156,8 +156,9 @@ pub fn p2_element(
     p2_element_with(x, du, states_n, mat, body_force, true)
 }
 
-/// [`p2_element`] without the tangent (left zero): the residual evaluations of Newton's line
-/// search and of the converged state read no tangent, and forming it was most of their cost.
+/// [`p2_element`] without the tangent (left zero), for evaluations where no tangent is read or
+/// cached (`StepProblem::evaluate`: the line search's and the converged state's residuals on
+/// the iterative path): forming it was most of their cost.
 pub fn p2_residual(
     x: &[[f64; 2]; N_NODES],
     du: &[[f64; 2]; N_NODES],
@@ -352,7 +353,10 @@ mod tests {
         let body = [0.5e3, -2.0e4];
         let full = p2_element(&x, &du, &prestress(), &elastic(), body).expect("valid element");
         let lean = p2_residual(&x, &du, &prestress(), &elastic(), body).expect("valid element");
-        assert_eq!(full.residual.map(f64::to_bits), lean.residual.map(f64::to_bits));
+        assert_eq!(
+            full.residual.map(f64::to_bits),
+            lean.residual.map(f64::to_bits)
+        );
         assert_eq!(format!("{:?}", full.states), format!("{:?}", lean.states));
         assert!(lean.tangent.iter().flatten().all(|&k| k == 0.0));
         assert!(full.tangent.iter().flatten().any(|&k| k != 0.0));

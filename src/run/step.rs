@@ -340,11 +340,14 @@ impl Simulation {
                 code: -1,
                 message: e.to_string(),
             })?;
-            let (d_nnz, o_nnz) = space.interpolation_preallocation(dofs);
-            let interpolation =
-                Mat::aij_rect(world, [dofs.n_owned_dofs, space.n_owned], 2, &d_nnz, &o_nnz)?;
-            let (d_nnz, o_nnz) = CoarseSpace::operator_preallocation(dofs);
-            let coarse = Mat::aij(world, space.n_owned, 2, &d_nnz, &o_nnz)?;
+            let interpolation = {
+                let (d_nnz, o_nnz) = CoarseSpace::interpolation_preallocation(dofs);
+                Mat::aij_rect(world, [dofs.n_owned_dofs, space.n_owned], 2, &d_nnz, &o_nnz)?
+            };
+            let coarse = {
+                let (d_nnz, o_nnz) = CoarseSpace::operator_preallocation(dofs);
+                Mat::aij(world, space.n_owned, 2, &d_nnz, &o_nnz)?
+            };
             Some(PMultigrid {
                 space,
                 interpolation,

@@ -22,7 +22,7 @@ impl Constraints {
     /// straight constrained side stays straight.
     pub fn build(dofs: &DofMap, point_bc: impl Fn(usize) -> [Option<f64>; 2]) -> Constraints {
         let n_vertex = dofs.n_nodes() - dofs.edges.len();
-        let mut c = Constraints::free(dofs.n_nodes());
+        let mut c = Constraints::none(dofs.n_nodes());
         for n in 0..n_vertex {
             c.set(n, point_bc(dofs.node_point[n] as usize));
         }
@@ -35,7 +35,7 @@ impl Constraints {
     }
 
     /// `n_nodes` nodes, none prescribed.
-    fn free(n_nodes: usize) -> Constraints {
+    fn none(n_nodes: usize) -> Constraints {
         Constraints {
             mask: vec![0; n_nodes],
             values: Vec::new(),
@@ -44,7 +44,8 @@ impl Constraints {
 
     /// Nodes must come in increasing order.
     fn set(&mut self, n: usize, g: [Option<f64>; 2]) {
-        let bits = g[0].is_some() as u8 | (g[1].is_some() as u8) << 1;
+        debug_assert!(self.values.last().is_none_or(|&(m, _)| m < n));
+        let bits = u8::from(g[0].is_some()) | (u8::from(g[1].is_some()) << 1);
         if bits != 0 {
             self.mask[n] = bits;
             self.values
@@ -54,7 +55,7 @@ impl Constraints {
 
     /// Whether component `c` of node `n` is prescribed (a pressure, `c` = 2, never is).
     pub fn is_fixed(&self, n: usize, c: usize) -> bool {
-        c < 2 && self.mask[n] >> c & 1 == 1
+        c < 2 && self.mask[n] & (1 << c) != 0
     }
 
     /// The prescribed step displacement of component `c` of node `n`, if it is prescribed.
@@ -85,7 +86,7 @@ mod tests {
 
     #[test]
     fn only_prescribed_components_have_values() {
-        let mut c = Constraints::free(5);
+        let mut c = Constraints::none(5);
         c.set(0, [None, None]);
         c.set(1, [Some(0.5), None]);
         c.set(3, [Some(-2.0), Some(-1.0)]);

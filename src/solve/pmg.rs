@@ -15,7 +15,9 @@ use crate::fem::p2::EDGES;
 use crate::mesh::LocalMesh;
 use pfem_partition::{allgather_u64, exscan_u64, Comm, PartitionError};
 
-/// The P1 space on this rank: numbering, interpolation pattern and coarse operator pattern.
+/// The P1 space on this rank: its numbering. The interpolation's and coarse operator's
+/// preallocations are made on demand ([`Self::interpolation_preallocation`],
+/// [`Self::operator_preallocation`]).
 pub struct CoarseSpace {
     /// Owned coarse dofs (2 per owned vertex node).
     pub n_owned: usize,
@@ -52,7 +54,7 @@ impl CoarseSpace {
     /// Per owned P2 row of the interpolation, its nonzeros in owned and in other ranks'
     /// columns. Made on demand and dropped once the matrix is preallocated: kept, the counts of
     /// both matrices would sit under the memory peak of every Newton iteration.
-    pub fn interpolation_preallocation(&self, dofs: &DofMap) -> (Vec<usize>, Vec<usize>) {
+    pub fn interpolation_preallocation(dofs: &DofMap) -> (Vec<usize>, Vec<usize>) {
         let (mut d_nnz, mut o_nnz) = (Vec::new(), Vec::new());
         for n in (0..dofs.n_nodes()).filter(|&n| dofs.node_owned[n]) {
             let ends = interpolation_ends(dofs, n);
