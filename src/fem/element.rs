@@ -156,20 +156,10 @@ pub fn p2_element(
     p2_element_with(x, du, states_n, mat, body_force, true)
 }
 
-/// [`p2_element`] without the tangent (left zero), for evaluations where no tangent is read or
-/// cached (`StepProblem::evaluate`: the line search's and the converged state's residuals on
-/// the iterative path): forming it was most of their cost.
-pub fn p2_residual(
-    x: &[[f64; 2]; N_NODES],
-    du: &[[f64; 2]; N_NODES],
-    states_n: &[GaussState; N_GAUSS],
-    mat: &dyn Material,
-    body_force: [f64; 2],
-) -> Result<ElementOutput, ElementError> {
-    p2_element_with(x, du, states_n, mat, body_force, false)
-}
-
-fn p2_element_with(
+/// [`p2_element`], with the tangent formed only if `with_tangent` (else left zero), for
+/// evaluations where no tangent is read or cached (`StepProblem::evaluate`: the line search's and
+/// the converged state's residuals on the iterative path): forming it was most of their cost.
+pub fn p2_element_with(
     x: &[[f64; 2]; N_NODES],
     du: &[[f64; 2]; N_NODES],
     states_n: &[GaussState; N_GAUSS],
@@ -352,7 +342,8 @@ mod tests {
         let du = homogeneous_du(&x, &f, [0.5, 0.2]);
         let body = [0.5e3, -2.0e4];
         let full = p2_element(&x, &du, &prestress(), &elastic(), body).expect("valid element");
-        let lean = p2_residual(&x, &du, &prestress(), &elastic(), body).expect("valid element");
+        let lean =
+            p2_element_with(&x, &du, &prestress(), &elastic(), body, false).expect("valid element");
         assert_eq!(
             full.residual.map(f64::to_bits),
             lean.residual.map(f64::to_bits)

@@ -5,7 +5,7 @@
 
 use super::pmg::CoarseSpace;
 use super::{Constraints, DofMap};
-use crate::fem::element::{p2_element, p2_residual};
+use crate::fem::element::p2_element_with;
 use crate::fem::mixed::p2p1_element;
 use crate::fem::p2::straight_sided;
 use crate::fem::surface_load::edge_pressure;
@@ -340,13 +340,19 @@ impl<'a> StepProblem<'a> {
         let flat = |k: &[f64]| if tangent { k.to_vec() } else { Vec::new() };
         let result = match s.kernel {
             Kernel::P2 => {
-                let element = if tangent { p2_element } else { p2_residual };
-                element(&geometry, &du, &s.states_n[t], s.material, s.body_force).map(|e| {
-                    ElementResult {
-                        residual: e.residual.to_vec(),
-                        tangent: flat(e.tangent.as_flattened()),
-                        states: e.states,
-                    }
+                let (material, body_force) = (s.material, s.body_force);
+                p2_element_with(
+                    &geometry,
+                    &du,
+                    &s.states_n[t],
+                    material,
+                    body_force,
+                    tangent,
+                )
+                .map(|e| ElementResult {
+                    residual: e.residual.to_vec(),
+                    tangent: flat(e.tangent.as_flattened()),
+                    states: e.states,
                 })
             }
             Kernel::P2P1 { bulk, scale } => {
