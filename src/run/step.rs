@@ -6,7 +6,7 @@ use crate::mapping::{recover_at_particles, TriStates};
 use crate::material::GaussState;
 use crate::mesh::LocalMesh;
 use crate::petsc::linear::{p_multigrid_from_options, upper_triangle_smoother_from_options};
-use crate::petsc::matrix::to_ints;
+use crate::petsc::matrix::{to_int, to_ints};
 use crate::petsc::{
     IndexSet, LinearSolver, Mat, NullSpace, PVec, Petsc, PetscError, Snes, SolveFailure,
 };
@@ -867,8 +867,7 @@ fn fill_p_multigrid(
     // Rank-local insertions; a failure on any rank is agreed on before the collective
     // assembly, so that no rank waits in it alone.
     let local = m.space.interpolation(dofs, setup.constraints, |r, c, w| {
-        let row = to_ints(&[r], "dof")?;
-        p.add_values(&row, &to_ints(c, "dof")?, w)
+        p.add_values(&[to_int(r, "dof")?], &to_ints(c, "dof")?, w)
     });
     let failed = sum_f64(world, &[if local.is_err() { 1.0 } else { 0.0 }])[0];
     match local {

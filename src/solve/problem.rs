@@ -339,22 +339,19 @@ impl<'a> StepProblem<'a> {
         let geometry = self.geometry(t);
         let flat = |k: &[f64]| if tangent { k.to_vec() } else { Vec::new() };
         let result = match s.kernel {
-            Kernel::P2 => {
-                let (material, body_force) = (s.material, s.body_force);
-                p2_element_with(
-                    &geometry,
-                    &du,
-                    &s.states_n[t],
-                    material,
-                    body_force,
-                    tangent,
-                )
-                .map(|e| ElementResult {
-                    residual: e.residual.to_vec(),
-                    tangent: flat(e.tangent.as_flattened()),
-                    states: e.states,
-                })
-            }
+            Kernel::P2 => p2_element_with(
+                &geometry,
+                &du,
+                &s.states_n[t],
+                s.material,
+                s.body_force,
+                tangent,
+            )
+            .map(|e| ElementResult {
+                residual: e.residual.to_vec(),
+                tangent: flat(e.tangent.as_flattened()),
+                states: e.states,
+            }),
             Kernel::P2P1 { bulk, scale } => {
                 let p: [f64; 3] = std::array::from_fn(|k| scale * at(12 + k));
                 p2p1_element(
