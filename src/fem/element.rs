@@ -219,37 +219,48 @@ pub fn p2_element_with(
             continue;
         }
 
-        // Weighted D·B, so the material stiffness below is a plain Bᵀ·(wDB) product.
-        let mut db = [[0.0; N_DOFS]; 4];
-        for (dbi, di) in db.iter_mut().zip(d.iter()) {
-            for (dij, bj) in di.iter().zip(b.iter()) {
-                let c = w * dij;
+        // Weighted D·B on the in-plane rows (B's zz row is zero), so the material stiffness
+        // below is a plain Bᵀ·(wDB) product. The tangent is symmetric (the geometric part
+        // always, the material part for the laws here): its upper triangle is formed, and
+        // mirrored once after the last Gauss point, which halves the work.
+        const IN_PLANE: [usize; 3] = [0, 1, 3];
+        debug_assert!(
+            (0..4).all(|i| (0..i)
+                .all(|j| (d[i][j] - d[j][i]).abs() <= 1e-9 * d[i][i].abs().max(d[j][j].abs()))),
+            "the material tangent is not symmetric: {d:?}"
+        );
+        let mut db = [[0.0; N_DOFS]; 3];
+        for (dbi, &i) in db.iter_mut().zip(IN_PLANE.iter()) {
+            for &jj in IN_PLANE.iter() {
+                let c = w * d[i][jj];
                 if c != 0.0 {
-                    for (x_, bjk) in dbi.iter_mut().zip(bj.iter()) {
+                    for (x_, bjk) in dbi.iter_mut().zip(b[jj].iter()) {
                         *x_ += c * bjk;
                     }
                 }
             }
         }
-
         for (k, row) in tangent.iter_mut().enumerate() {
-            for (bi, dbi) in b.iter().zip(db.iter()) {
-                let bik = bi[k];
-                if bik != 0.0 {
-                    for (r, v) in row.iter_mut().zip(dbi.iter()) {
-                        *r += bik * v;
-                    }
-                }
+            let bk = [b[0][k], b[1][k], b[3][k]];
+            for (l, r) in row.iter_mut().enumerate().skip(k) {
+                *r += bk[0] * db[0][l] + bk[1] * db[1][l] + bk[2] * db[2][l];
             }
         }
 
         // Geometric stiffness: (∇N_a · S ∇N_b) on both diagonal displacement components.
         for (a, ga) in g.iter().enumerate() {
             let sa = [s[0] * ga[0] + s[3] * ga[1], s[3] * ga[0] + s[1] * ga[1]];
-            for (bn, gb) in g.iter().enumerate() {
+            for (bn, gb) in g.iter().enumerate().skip(a) {
                 let kg = w * (sa[0] * gb[0] + sa[1] * gb[1]);
                 tangent[2 * a][2 * bn] += kg;
                 tangent[2 * a + 1][2 * bn + 1] += kg;
+            }
+        }
+    }
+    if with_tangent {
+        for k in 0..N_DOFS {
+            for l in 0..k {
+                tangent[k][l] = tangent[l][k];
             }
         }
     }

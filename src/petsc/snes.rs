@@ -101,6 +101,26 @@ impl Snes {
                 ),
                 "SNESSetLagPreconditioner",
             )?;
+            if let Some(cap) = linear.inexact_newton_cap() {
+                let default = ffi::PETSC_DEFAULT as f64;
+                check(
+                    ffi::SNESKSPSetUseEW(raw, ffi::PetscBool_PETSC_TRUE),
+                    "SNESKSPSetUseEW",
+                )?;
+                check(
+                    ffi::SNESKSPSetParametersEW(
+                        raw,
+                        ffi::PETSC_DEFAULT as ffi::PetscInt,
+                        default,
+                        cap,
+                        default,
+                        default,
+                        default,
+                        default,
+                    ),
+                    "SNESKSPSetParametersEW",
+                )?;
+            }
             // The caller's line search: full steps for elastic large rotations (the residual grows
             // on the first iterate before the quadratic phase, and backtracking would crawl),
             // backtracking for plastic flow (elastic-plastic switching overshoots).
