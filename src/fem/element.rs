@@ -258,9 +258,10 @@ pub fn p2_element_with(
         }
     }
     if with_tangent {
-        for k in 0..N_DOFS {
-            for l in 0..k {
-                tangent[k][l] = tangent[l][k];
+        for k in 1..N_DOFS {
+            let (upper, lower) = tangent.split_at_mut(k);
+            for (l, row) in upper.iter().enumerate() {
+                lower[0][l] = row[k];
             }
         }
     }
