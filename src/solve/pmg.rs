@@ -137,16 +137,24 @@ impl CoarseSpace {
             std::array::from_fn(|d| !fixed(nodes[d / 2] as usize, d % 2)),
             std::array::from_fn(|d| !fixed(v[d / 2], d % 2)),
         );
-        // Coarse dofs come in (x, y) pairs at (2 b, 2 b + 1): whole 2 × 2 blocks.
-        let blocks: [usize; 3] = std::array::from_fn(|a| self.coarse_dof[v[a]] / 2);
+        // Coarse dofs come in (x, y) pairs at (2 b, 2 b + 1): whole 2 × 2 blocks, the columns
+        // in increasing order, where PETSc's insertion continues its search from the last one.
+        let mut order = [0, 1, 2];
+        order.sort_unstable_by_key(|&a| self.coarse_dof[v[a]]);
+        let blocks: [usize; 3] = std::array::from_fn(|b| self.coarse_dof[v[order[b]]] / 2);
         let (mut rows, mut vals) = ([0; 3], [0.0; 36]);
         let (mut n_rows, mut diagonal_sum) = (0, 0.0);
-        for a in (0..3).filter(|&a| dofs.node_owned[v[a]]) {
-            rows[n_rows] = blocks[a];
+        for (a, &block) in order.iter().zip(&blocks) {
+            if !dofs.node_owned[v[*a]] {
+                continue;
+            }
+            rows[n_rows] = block;
             for (r, i) in [2 * a, 2 * a + 1].into_iter().enumerate() {
                 let at = 12 * n_rows + 6 * r;
-                vals[at..at + 6].copy_from_slice(&coarse[i]);
-                if !fixed(v[a], i % 2) {
+                for (out, &b) in vals[at..at + 6].chunks_exact_mut(2).zip(&order) {
+                    out.copy_from_slice(&coarse[i][2 * b..2 * b + 2]);
+                }
+                if !fixed(v[*a], i % 2) {
                     diagonal_sum += coarse[i][i];
                 }
             }
