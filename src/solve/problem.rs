@@ -82,10 +82,10 @@ pub struct StepProblem<'a> {
     dofs: &'a DofMap,
     setup: StepSetup<'a>,
     scatter: Scatter,
-    /// Local-vector index of every element dof, `dofs_per_element` per triangle, flat (u32:
-    /// a rank's local vector stays far below 4 G entries, and at a million particles per rank
-    /// per-triangle vectors of usize cost 170 bytes a triangle more).
-    element_dofs: Vec<u32>,
+    /// Element dofs per triangle: 12 displacements, and 3 pressures for the mixed kernel. A
+    /// triangle's local and global dof indices are derived from its nodes when needed
+    /// ([`Self::local_dof`], [`Self::sorted_columns`]): kept per triangle, they were 108 bytes
+    /// a triangle (about 4 % of the memory peak of the iterative path).
     dofs_per_element: usize,
     /// The diagonal of a constrained row: the mean diagonal of the free displacement rows, so
     /// that the constrained rows neither stand out of an AMG hierarchy nor spoil the
@@ -107,11 +107,6 @@ pub struct StepProblem<'a> {
     /// assembles them one at a time (one more element pass per Newton iteration).
     cache: RefCell<Option<(Vec<f64>, Vec<ElementResult>)>>,
     keep_elements: bool,
-    /// Per triangle, `n` global columns in increasing order and, for each, its element dof:
-    /// PETSc's MatSetValues searches a row's columns from the last one found, so sorted
-    /// columns make each search short.
-    sorted_cols: Vec<Int>,
-    sorted_dofs: Vec<u8>,
 }
 
 /// The pressure mass matrix scaled by −1/G that a Schur-complement preconditioner uses, and
@@ -140,34 +135,9 @@ impl<'a> StepProblem<'a> {
         let scatter = Scatter::new(template, &dofs.local_to_global())?;
         let mixed = matches!(setup.kernel, Kernel::P2P1 { .. });
         let dofs_per_element = if mixed { 15 } else { 12 };
-        let local_index = |i: usize| {
-            u32::try_from(i).map_err(|_| PetscError {
-                code: -1,
-                message: format!("local dof {i} does not fit 32 bits"),
-            })
-        };
-        let mut element_dofs = Vec::with_capacity(dofs_per_element * dofs.tri_nodes.len());
-        for nodes in &dofs.tri_nodes {
-            for &n in nodes {
-                let first = dofs.node_local[n as usize];
-                element_dofs.extend([local_index(first)?, local_index(first + 1)?]);
-            }
-            if mixed {
-                for &n in &nodes[..3] {
-                    element_dofs.push(local_index(dofs.node_local[n as usize] + 2)?);
-                }
-            }
-        }
-        let l2g = dofs.local_to_global();
-        let mut sorted_cols = Vec::with_capacity(element_dofs.len());
-        let mut sorted_dofs = Vec::with_capacity(element_dofs.len());
-        for d in element_dofs.chunks(dofs_per_element) {
-            let mut order: Vec<u8> = (0..d.len() as u8).collect();
-            order.sort_by_key(|&k| l2g[d[k as usize] as usize]);
-            for &k in &order {
-                sorted_cols.push(to_int(l2g[d[k as usize] as usize], "dof")?);
-            }
-            sorted_dofs.extend_from_slice(&order);
+        // The global columns are PETSc ints; check the largest once here, not per entry.
+        if dofs.n_global_dofs > 0 {
+            to_int(dofs.n_global_dofs - 1, "dof")?;
         }
         Ok(StepProblem {
             comm,
@@ -175,16 +145,49 @@ impl<'a> StepProblem<'a> {
             dofs,
             setup,
             scatter,
-            element_dofs,
             dofs_per_element,
             diagonal: Cell::new(None),
             schur: None,
             coarse: None,
             cache: RefCell::new(None),
             keep_elements: true,
-            sorted_cols,
-            sorted_dofs,
         })
+    }
+
+    /// The local-vector index of element dof `k` of triangle `t` (x and y of the six nodes,
+    /// then the vertices' pressures).
+    fn local_dof(&self, t: usize, k: usize) -> usize {
+        let nodes = &self.dofs.tri_nodes[t];
+        if k < 12 {
+            self.dofs.node_local[nodes[k / 2] as usize] + k % 2
+        } else {
+            self.dofs.node_local[nodes[k - 12] as usize] + 2
+        }
+    }
+
+    /// Triangle `t`'s global columns in increasing order into `cols` and, for each, its element
+    /// dof into `order`: PETSc's MatSetValues searches a row's columns from the last one found,
+    /// so sorted columns make each search short. A node's dofs are consecutive, x first.
+    fn sorted_columns(&self, t: usize, cols: &mut [Int], order: &mut [u8]) {
+        let nodes = &self.dofs.tri_nodes[t];
+        let global = |k: usize| {
+            if k < 12 {
+                self.dofs.node_global[nodes[k / 2] as usize] + k % 2
+            } else {
+                self.dofs.node_global[nodes[k - 12] as usize] + 2
+            }
+        };
+        let n = self.dofs_per_element;
+        let mut keyed = [(0usize, 0u8); 15];
+        for (k, slot) in keyed[..n].iter_mut().enumerate() {
+            *slot = (global(k), k as u8);
+        }
+        keyed[..n].sort_unstable();
+        for ((c, o), &(g, k)) in cols.iter_mut().zip(order.iter_mut()).zip(&keyed[..n]) {
+            // In range: `new` checked the largest global dof.
+            *c = g as Int;
+            *o = k;
+        }
     }
 
     fn n_triangles(&self) -> usize {
@@ -332,9 +335,7 @@ impl<'a> StepProblem<'a> {
         tangent: bool,
     ) -> Result<ElementResult, String> {
         let s = &self.setup;
-        let n = self.dofs_per_element;
-        let dofs = &self.element_dofs[t * n..(t + 1) * n];
-        let at = |k: usize| local[dofs[k] as usize];
+        let at = |k: usize| local[self.local_dof(t, k)];
         let du: [[f64; 2]; 6] = std::array::from_fn(|k| [at(2 * k), at(2 * k + 1)]);
         let geometry = self.geometry(t);
         let flat = |k: &[f64]| if tangent { k.to_vec() } else { Vec::new() };
@@ -752,7 +753,7 @@ impl NonlinearProblem for StepProblem<'_> {
         let mut block_cols = Vec::with_capacity(6);
         let mut rows = Vec::new();
         let mut vals = Vec::new();
-        let mut start = 0;
+        let (mut sorted_cols, mut sorted_dofs) = ([0 as Int; 15], [0u8; 15]);
         let evaluated = self.evaluate(x, true, |t, e| {
             if let Some(c) = &self.coarse {
                 let m = c.matrix.as_ref();
@@ -775,9 +776,8 @@ impl NonlinearProblem for StepProblem<'_> {
                     .map_err(fatal)?;
             }
             let n = e.residual.len();
-            let cols = &self.sorted_cols[start..start + n];
-            let order = &self.sorted_dofs[start..start + n];
-            start += n;
+            self.sorted_columns(t, &mut sorted_cols, &mut sorted_dofs);
+            let (cols, order) = (&sorted_cols[..n], &sorted_dofs[..n]);
             // Prescribed columns are zeroed (not dropped, so the pattern stays): with the
             // constrained rows holding only their diagonal, the matrix stays as symmetric as
             // the tangent. Newton keeps prescribed dofs at their values, so their columns
