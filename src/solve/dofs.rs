@@ -212,11 +212,32 @@ impl DofMap {
             .collect()
     }
 
-    /// Global indices of the local vector (node order): what the scatter gathers.
-    pub fn local_to_global(&self) -> Vec<usize> {
+    /// Global indices of the dofs of the nodes this rank does not own (node order): what the
+    /// ghost scatter gathers. Owned values are read from the global vector in place.
+    pub fn ghost_globals(&self) -> Vec<usize> {
         (0..self.n_nodes())
+            .filter(|&n| !self.node_owned[n])
             .flat_map(|n| (0..self.ndof(n)).map(move |c| self.node_global[n] + c))
             .collect()
+    }
+
+    /// The local vector (every local node's dofs, node order) from this rank's owned entries
+    /// of the global vector and the ghost values in [`Self::ghost_globals`] order.
+    pub fn local_vector(&self, owned: &[f64], ghosts: &[f64]) -> Vec<f64> {
+        let n_local = self.node_local.last().map_or(0, |&o| o + self.ndof(self.n_nodes() - 1));
+        let mut local = Vec::with_capacity(n_local);
+        let mut ghost = 0;
+        for n in 0..self.n_nodes() {
+            let nd = self.ndof(n);
+            if self.node_owned[n] {
+                let o = self.node_global[n] - self.first_dof;
+                local.extend_from_slice(&owned[o..o + nd]);
+            } else {
+                local.extend_from_slice(&ghosts[ghost..ghost + nd]);
+                ghost += nd;
+            }
+        }
+        local
     }
 
     /// Per owned vertex node, in node order: how many vertex nodes (itself included) share a
