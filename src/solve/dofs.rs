@@ -224,7 +224,10 @@ impl DofMap {
     /// The local vector (every local node's dofs, node order) from this rank's owned entries
     /// of the global vector and the ghost values in [`Self::ghost_globals`] order.
     pub fn local_vector(&self, owned: &[f64], ghosts: &[f64]) -> Vec<f64> {
-        let n_local = self.node_local.last().map_or(0, |&o| o + self.ndof(self.n_nodes() - 1));
+        let n_local = self
+            .node_local
+            .last()
+            .map_or(0, |&o| o + self.ndof(self.n_nodes() - 1));
         let mut local = Vec::with_capacity(n_local);
         let mut ghost = 0;
         for n in 0..self.n_nodes() {

@@ -256,8 +256,9 @@ impl<'a> StepProblem<'a> {
     pub fn local_values(&self, x: VecRef<'_>) -> Result<Vec<f64>, PetscError> {
         // Only the ghosts travel: a scatter of the whole local vector held index arrays and a
         // sequential copy of it (4.7 % of the iterative path's memory peak on one rank).
-        self.scatter
-            .gather(x, |ghosts| x.read(|owned| self.dofs.local_vector(owned, ghosts)))?
+        self.scatter.gather(x, |ghosts| {
+            x.read(|owned| self.dofs.local_vector(owned, ghosts))
+        })?
     }
 
     /// Step displacement of every local node.
