@@ -3,6 +3,7 @@
 mod adapt;
 mod contact;
 mod error;
+mod node_values;
 mod output;
 mod progress;
 mod rank_table;

@@ -115,19 +115,18 @@ impl Simulation {
                 .iter()
                 .flat_map(|r| r.chunks_exact(3 + GAUSS_LEN + NODE_LEN + CONTACT_LEN))
         };
-        let mut last = self.last_nodes.borrow_mut();
-        last.clear();
+        let mut last = Vec::new();
         for c in chunks() {
             let nodes = &c[3 + GAUSS_LEN..];
             for (k, node) in tri_node_keys(&[c[0], c[1], c[2]]).iter().enumerate() {
                 let v: [f64; 3] = std::array::from_fn(|i| f64::from_bits(nodes[3 * k + i]));
                 // A node's displacement is NaN only where it was not stored.
                 if !v[0].is_nan() {
-                    last.insert(*node, v);
+                    last.push((*node, v));
                 }
             }
         }
-        drop(last);
+        *self.last_nodes.borrow_mut() = super::node_values::NodeValues::new(last);
         let mut touching = self.last_contact.borrow_mut();
         touching.clear();
         for c in chunks() {
