@@ -225,8 +225,8 @@ pub fn p2_element_with(
         // mirrored once after the last Gauss point, which halves the work.
         const IN_PLANE: [usize; 3] = [0, 1, 3];
         debug_assert!(
-            (0..4).all(|i| (0..i)
-                .all(|j| (d[i][j] - d[j][i]).abs() <= 1e-9 * d[i][i].abs().max(d[j][j].abs()))),
+            (0..4).all(|i| (0..i).all(|j| (d[i][j] - d[j][i]).abs()
+                <= 1e-9 * d.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs())))),
             "the material tangent is not symmetric: {d:?}"
         );
         let mut db = [[0.0; N_DOFS]; 3];

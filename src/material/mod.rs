@@ -124,7 +124,9 @@ pub trait Material: Send + Sync + fmt::Debug {
     /// `state_n` is the converged state at x_n (its `stress` is the Cauchy stress σ_n);
     /// `e` is the Green–Lagrange strain of the step relative to x_n (Voigt, engineering shear,
     /// `e[2] = 0` in plane strain). Must not mutate anything: Newton iterations call it repeatedly
-    /// from the same `state_n`.
+    /// from the same `state_n`. `d` must be symmetric (the P2 element forms the upper triangle
+    /// of its tangent and mirrors it): a law with a non-symmetric tangent (non-associated flow)
+    /// would need the element's full product back.
     fn update(&self, state_n: &GaussState, e: &[f64; 4])
         -> Result<MaterialResponse, MaterialError>;
 

@@ -3,7 +3,7 @@ use super::ffi;
 use super::vector::{PVec, VecRef};
 
 /// Gathers chosen global entries of a distributed vector into a sequential local vector: the
-/// owned-plus-ghost values one rank's elements need.
+/// ghost values one rank's elements need (owned values are read from the vector in place).
 pub struct Scatter {
     raw: ffi::VecScatter,
     local: PVec,

@@ -334,3 +334,34 @@ impl DofMap {
         (d, o)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_local_vector_interleaves_owned_values_and_ghosts_in_node_order() {
+        // Two vertex nodes of a mixed mesh (3 dofs) and two midside nodes (2 dofs); this rank
+        // owns nodes 0 and 3, whose dofs start at its first dof 100.
+        let dofs = DofMap {
+            node_of_point: vec![0, 1],
+            edges: vec![[0, 1], [1, 0]],
+            tri_nodes: Vec::new(),
+            node_global: vec![100, 50, 60, 103],
+            node_local: vec![0, 3, 6, 8],
+            vertex_dofs: 3,
+            node_owned: vec![true, false, false, true],
+            node_point: vec![0, 1, u32::MAX, u32::MAX],
+            n_owned_dofs: 5,
+            first_dof: 100,
+            n_global_dofs: 200,
+        };
+        assert_eq!(dofs.ghost_globals(), vec![50, 51, 52, 60, 61]);
+        let owned = [1.0, 2.0, 3.0, 4.0, 5.0];
+        let ghosts = [50.0, 51.0, 52.0, 60.0, 61.0];
+        assert_eq!(
+            dofs.local_vector(&owned, &ghosts),
+            vec![1.0, 2.0, 3.0, 50.0, 51.0, 52.0, 60.0, 61.0, 4.0, 5.0]
+        );
+    }
+}

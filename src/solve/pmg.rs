@@ -319,6 +319,59 @@ mod tests {
     }
 
     #[test]
+    fn galerkin_blocks_reach_petsc_under_their_own_columns_in_increasing_order() {
+        // One triangle whose vertices' coarse numbers run against their local order.
+        let dofs = DofMap {
+            node_of_point: vec![0, 1, 2],
+            edges: vec![[0, 1], [1, 2], [0, 2]],
+            tri_nodes: vec![[0, 1, 2, 3, 4, 5]],
+            node_global: vec![0, 2, 4, 6, 8, 10],
+            node_local: vec![0, 2, 4, 6, 8, 10],
+            vertex_dofs: 2,
+            node_owned: vec![true; 6],
+            node_point: vec![0, 1, 2, u32::MAX, u32::MAX, u32::MAX],
+            n_owned_dofs: 12,
+            first_dof: 0,
+            n_global_dofs: 12,
+        };
+        let space = CoarseSpace {
+            n_owned: 6,
+            coarse_dof: vec![4, 0, 2],
+        };
+        let constraints = Constraints::build(&dofs, |_| [None, None]);
+        let tangent = p2_tangent([[0.1, 0.2], [1.3, 0.1], [0.4, 0.9]], 1.0e6, 0.3);
+        let want = galerkin_product(&tangent, [true; 12], [true; 6]);
+        let (mut rows, mut cols, mut vals) = (Vec::new(), Vec::new(), Vec::new());
+        space
+            .galerkin_element(&dofs, &constraints, 0, &tangent, |r, c, v| {
+                rows.extend_from_slice(r);
+                cols.extend_from_slice(c);
+                vals.extend_from_slice(v);
+                Ok::<(), ()>(())
+            })
+            .unwrap();
+        assert_eq!(cols, vec![0, 1, 2], "block columns in increasing order");
+        let vertex_of_block = |b: usize| (0..3).find(|&a| space.coarse_dof[a] / 2 == b).unwrap();
+        for (n, &r) in rows.iter().enumerate() {
+            let a = vertex_of_block(r);
+            for i in 0..2 {
+                for (j, &c) in cols.iter().enumerate() {
+                    let b = vertex_of_block(c);
+                    for k in 0..2 {
+                        let got = vals[12 * n + 6 * i + 2 * j + k];
+                        assert_eq!(
+                            got,
+                            want[2 * a + i][2 * b + k],
+                            "block ({r}, {c}), ({i}, {k})"
+                        );
+                    }
+                }
+            }
+        }
+        assert_eq!(rows.len(), 3);
+    }
+
+    #[test]
     fn prescribed_dofs_take_no_part_in_the_galerkin_product() {
         let x = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
         let tangent = p2_tangent(x, 1.0e6, 0.25);

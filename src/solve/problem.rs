@@ -488,8 +488,8 @@ impl<'a> StepProblem<'a> {
         }
     }
 
-    /// The owned, unconstrained row of element dof `k` of triangle `t` (local-vector index
-    /// `dofs[k]`), if any.
+    /// The owned, unconstrained row of element dof `k` of triangle `t`, as an offset among this
+    /// rank's owned rows, if any.
     fn free_row(&self, t: usize, k: usize) -> Option<usize> {
         let node = self.dofs.tri_nodes[t][if k < 12 { k / 2 } else { k - 12 }] as usize;
         let c = if k < 12 { k % 2 } else { 2 };
