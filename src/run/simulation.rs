@@ -3,7 +3,7 @@
 use super::RunError;
 use crate::case_file::{read_checkpoint, CaseHeader};
 use crate::history::Measures;
-use crate::mapping::{map_states, TriStates};
+use crate::mapping::{map_states, StartStates, TriStates};
 use crate::material::GaussState;
 use crate::mesh::local::halo_width;
 use crate::mesh::LocalMesh;
@@ -208,7 +208,7 @@ impl Simulation {
     /// consumed: the step sets new ones when it converges, and kept beside the solve they were
     /// 16 % of its memory peak from the second step on (the cantilever at h = 1/128, 1 rank:
     /// 880 MB at step 2 against 758 at step 1).
-    pub fn map(&mut self, mesh: &LocalMesh) -> Vec<[GaussState; 3]> {
+    pub fn map(&mut self, mesh: &LocalMesh) -> StartStates {
         let at_points: Vec<[f64; GaussState::LEN]> = self
             .particles
             .state
@@ -221,9 +221,10 @@ impl Simulation {
             old = TriStates::default();
         }
         let (states, stats) = map_states(&old, mesh, &at_points);
+        drop(old);
         self.remapped
             .set(self.remapped.get() + stats.interpolated_owned as u64);
-        states
+        StartStates::new(states, self.model.plastic())
     }
 
     pub(super) fn reference_position(&self, mesh: &LocalMesh, p: usize) -> [f64; 2] {

@@ -2,7 +2,7 @@
 //! then moving the particles and carrying the new Gauss states to them.
 
 use super::{Simulation, StepReport};
-use crate::mapping::{recover_at_particles, TriStates};
+use crate::mapping::{recover_at_particles, StartStates, TriStates};
 use crate::material::GaussState;
 use crate::mesh::LocalMesh;
 use crate::petsc::linear::{p_multigrid_from_options, upper_triangle_smoother_from_options};
@@ -201,7 +201,7 @@ impl Simulation {
         world: &Comm,
         petsc: &Petsc,
         mesh: &LocalMesh,
-        states_n: &[[GaussState; 3]],
+        states_n: &StartStates,
         from: f64,
         to: f64,
     ) -> Result<Solved, SolveError> {
@@ -774,7 +774,7 @@ impl Simulation {
         world: &Comm,
         petsc: &Petsc,
         mesh: &mut LocalMesh,
-        states: Vec<[GaussState; 3]>,
+        states: StartStates,
     ) -> Result<StepReport, super::RunError> {
         let full = 1.0 / self.model.scene.steps.count as f64;
         let target = self.model.load_factor(self.header.step + 1);

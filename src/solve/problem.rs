@@ -9,6 +9,7 @@ use crate::fem::element::p2_element_with;
 use crate::fem::mixed::p2p1_element;
 use crate::fem::p2::straight_sided;
 use crate::fem::surface_load::edge_pressure;
+use crate::mapping::StartStates;
 use crate::material::{GaussState, Material};
 use crate::mesh::LocalMesh;
 use crate::petsc::matrix::{to_int, MatRef};
@@ -34,7 +35,7 @@ pub struct StepSetup<'a> {
     pub material: &'a dyn Material,
     pub kernel: Kernel,
     /// Cauchy state at the start of the step, per local triangle and Gauss point.
-    pub states_n: &'a [[GaussState; 3]],
+    pub states_n: &'a StartStates,
     pub body_force: [f64; 2],
     pub constraints: &'a Constraints,
     /// Total external point forces on owned nodes at the end of the step: (node, force).
@@ -347,7 +348,7 @@ impl<'a> StepProblem<'a> {
             Kernel::P2 => p2_element_with(
                 &geometry,
                 &du,
-                &s.states_n[t],
+                &s.states_n.get(t),
                 s.material,
                 s.body_force,
                 tangent,
@@ -363,7 +364,7 @@ impl<'a> StepProblem<'a> {
                     &geometry,
                     &du,
                     &p,
-                    &s.states_n[t],
+                    &s.states_n.get(t),
                     s.material,
                     bulk,
                     s.body_force,
@@ -925,7 +926,7 @@ impl StepProblem<'_> {
             let g = super::split::effective_shear_modulus(
                 x,
                 &du,
-                &self.setup.states_n[t],
+                &self.setup.states_n.get(t),
                 self.setup.material,
             )
             .unwrap_or(f64::INFINITY);
