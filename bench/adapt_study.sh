@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Run time against error with `[mesh.adapt]` (issue 10, item 5, last sentence) for SCENE
-# (`footing` or `tbar-smooth`): one run of the scene's short push (bench/error_vs_time.py `push`:
-# the footing's 2 m, z/B = 1; the T-bar's 0.25D) with the spacing factor FACTOR applied to
+# (`footing`, `tbar-smooth` or `pipeline`): one run of the scene's short push
+# (bench/error_vs_time.py `push`: the footing's 2 m, z/B = 1; the T-bar's 0.25D; the pipeline's
+# vertical stage alone, w = 0.5D) with the spacing factor FACTOR applied to
 # `mesh.h` and the `mesh.fine` regions (bench/error_vs_time.py `mesh`), STEPS steps, RANKS ranks,
 # the direct solver, and the `[mesh.adapt]` table ADAPT (empty: no adaptation), measured as
 # bench/error_vs_time.sh measures (`nice -n 19`, unbound `mpirun`, `/usr/bin/time` around each
@@ -9,8 +10,11 @@
 #   footing      the q/cu curve against the h/2 curve at z/B = 0.25-1, and the worst step from
 #                z/B = 0.25 on
 #   tbar-smooth  |mean Nc / 9.142 - 1| over the steps with w >= 0.1D
+#   pipeline     |V/(D cu) / V_ref - 1| at w = 0.5D, V_ref the reference of
+#                bench/results/pipeline.csv (as in pipeline.md: 4.4301, the finest spacing's value)
 # Appends a row to bench/results/SCENE-adapt.csv and the invocation to
-# bench/results/SCENE-adapt.commands. A run that fails or is cut by TIMEOUT (s of wall) gets a
+# bench/results/SCENE-adapt.commands. A setting `pfem-mpi new` refuses gets a row with its first
+# error line (exit 1). A run that fails or is cut by TIMEOUT (s of wall) gets a
 # row too, with its exit code, the last step it reached, the solver's first error line and the
 # figure measured so far (no error: it did not compute what was asked).
 #
@@ -20,14 +24,16 @@
 #
 # Usage: FACTOR=2 STEPS=100 RANKS=1 ADAPT='{h_min=0.125,h_max=1.0}' bench/adapt_study.sh footing
 #        FACTOR=2 STEPS=10 ADAPT='{h_min=0.005,h_max=0.04}' BIN=/path/pfem-mpi bench/adapt_study.sh tbar-smooth
+#        FACTOR=4 STEPS=50 ADAPT='{h_min=0.01,h_max=0.04}' EXTRA='mesh.fine=[]' bench/adapt_study.sh pipeline
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
-scene=${1:?usage: bench/adapt_study.sh footing|tbar-smooth}
+scene=${1:?usage: bench/adapt_study.sh footing|tbar-smooth|pipeline}
 case $scene in
   footing) default_steps=100 default_timeout=3000 ;;
   tbar-smooth) default_steps=10 default_timeout=900 ;;
-  *) echo "adapt_study.sh: unknown scene $scene (footing or tbar-smooth)" >&2 && exit 2 ;;
+  pipeline) default_steps=50 default_timeout=900 ;;
+  *) echo "adapt_study.sh: unknown scene $scene (footing, tbar-smooth or pipeline)" >&2 && exit 2 ;;
 esac
 helper=$root/bench/error_vs_time.py
 factor=${FACTOR:-1}
@@ -49,7 +55,14 @@ for s in "${mesh[@]}" "${push[@]}"; do sets+=(--set "$s"); done
 [[ -z $adapt ]] || sets+=(--set "mesh.adapt=$adapt")
 IFS=';' read -ra more <<<"$extra"
 for s in "${more[@]}"; do sets+=(--set "$s"); done
-"$bin" new "$scene" -o case.h5 "${sets[@]}" >new.log
+[[ -f $csv ]] || echo "factor,steps,ranks,adapt,particles_start,particles_end,cpu_s,newton_its,steps_cut,result" >"$csv"
+settings=$adapt${adapt:+${extra:+ }}$extra
+if ! "$bin" new "$scene" -o case.h5 "${sets[@]}" >new.log 2>&1; then
+  # A setting the scene refuses (e.g. a fine region off the coarser lattice) gets a row too.
+  result="not built (pfem-mpi new): $(grep -m1 -i error new.log | cut -c1-300)"
+  echo "$factor,$steps,$ranks,\"$settings\",,,,,,\"${result//\"/\'}\"" | tee -a "$csv"
+  exit 1
+fi
 particles=$("$bin" info case.h5 | awk '/^particles/ {print $2}')
 code=0
 SECONDS=0
@@ -79,6 +92,4 @@ else
   fi
 fi
 result=${result//\"/\'}
-[[ -f $csv ]] || echo "factor,steps,ranks,adapt,particles_start,particles_end,cpu_s,newton_its,steps_cut,result" >"$csv"
-settings=$adapt${adapt:+${extra:+ }}$extra
 echo "$factor,$steps,$ranks,\"$settings\",$particles,$last_particles,$cpu,$newton,$cuts,\"$result\"" | tee -a "$csv"
