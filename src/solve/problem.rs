@@ -787,23 +787,30 @@ impl NonlinearProblem for StepProblem<'_> {
             // constrained rows holding only their diagonal, the matrix stays as symmetric as
             // the tangent. Newton keeps prescribed dofs at their values, so their columns
             // would multiply a zero update anyway.
-            let entry = |k: usize, c: u8| {
-                let c = c as usize;
-                if self.constrained_column(t, c) {
-                    0.0
+            // Most triangles have no prescribed dof: one mask per triangle spares them a test
+            // per entry. A row's entries in the sorted column order, prescribed columns zero.
+            let fixed = (0..n)
+                .filter(|&k| self.constrained_column(t, k))
+                .fold(0u16, |m, k| m | 1 << k);
+            let push_row = |vals: &mut Vec<f64>, k: usize| {
+                let row = &e.tangent[k * n..][..n];
+                if fixed == 0 {
+                    vals.extend(order.iter().map(|&c| row[c as usize]));
                 } else {
-                    e.tangent[k * n + c]
+                    vals.extend(order.iter().map(|&c| {
+                        if fixed & 1 << c != 0 {
+                            0.0
+                        } else {
+                            row[c as usize]
+                        }
+                    }));
                 }
             };
             rows.clear();
             vals.clear();
             if blocked {
                 // A node's two dofs are adjacent in the sorted order, x first: whole 2 × 2
-                // blocks, with zero rows where a component is prescribed. Most triangles have
-                // no prescribed dof: one mask per triangle spares them a test per entry.
-                let fixed = (0..n)
-                    .filter(|&k| self.constrained_column(t, k))
-                    .fold(0u16, |m, k| m | 1 << k);
+                // blocks, with zero rows where a component is prescribed.
                 block_cols.clear();
                 block_cols.extend(cols.iter().step_by(2).map(|&c| c / 2));
                 for (pair, &col) in order.chunks(2).zip(cols.iter().step_by(2)) {
@@ -813,19 +820,10 @@ impl NonlinearProblem for StepProblem<'_> {
                     }
                     rows.push(col / 2);
                     for &k in pair {
-                        let row = &e.tangent[k as usize * n..][..n];
                         if fixed & 1 << k != 0 {
                             vals.extend(std::iter::repeat_n(0.0, n));
-                        } else if fixed == 0 {
-                            vals.extend(order.iter().map(|&c| row[c as usize]));
                         } else {
-                            vals.extend(order.iter().map(|&c| {
-                                if fixed & 1 << c != 0 {
-                                    0.0
-                                } else {
-                                    row[c as usize]
-                                }
-                            }));
+                            push_row(&mut vals, k as usize);
                         }
                     }
                 }
@@ -838,7 +836,7 @@ impl NonlinearProblem for StepProblem<'_> {
                 let k = k as usize;
                 if self.free_row(t, k).is_some() {
                     rows.push(row);
-                    vals.extend(order.iter().map(|&c| entry(k, c)));
+                    push_row(&mut vals, k);
                 }
             }
             if !rows.is_empty() {
