@@ -45,17 +45,6 @@ impl StartStates {
             }),
         }
     }
-
-    pub fn len(&self) -> usize {
-        match self {
-            StartStates::Full(s) => s.len(),
-            StartStates::StressOnly(s) => s.len(),
-        }
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
 }
 
 /// Gauss states of a mesh's triangles, looked up by global-id key.

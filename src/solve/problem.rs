@@ -155,28 +155,30 @@ impl<'a> StepProblem<'a> {
         })
     }
 
-    /// The local-vector index of element dof `k` of triangle `t` (x and y of the six nodes,
-    /// then the vertices' pressures).
-    fn local_dof(&self, t: usize, k: usize) -> usize {
+    /// The local node and component of element dof `k` of triangle `t`: x and y of the six
+    /// nodes, then the vertices' pressures (component 2).
+    fn element_dof(&self, t: usize, k: usize) -> (usize, usize) {
         let nodes = &self.dofs.tri_nodes[t];
         if k < 12 {
-            self.dofs.node_local[nodes[k / 2] as usize] + k % 2
+            (nodes[k / 2] as usize, k % 2)
         } else {
-            self.dofs.node_local[nodes[k - 12] as usize] + 2
+            (nodes[k - 12] as usize, 2)
         }
+    }
+
+    /// The local-vector index of element dof `k` of triangle `t`.
+    fn local_dof(&self, t: usize, k: usize) -> usize {
+        let (node, c) = self.element_dof(t, k);
+        self.dofs.node_local[node] + c
     }
 
     /// Triangle `t`'s global columns in increasing order into `cols` and, for each, its element
     /// dof into `order`: PETSc's MatSetValues searches a row's columns from the last one found,
     /// so sorted columns make each search short. A node's dofs are consecutive, x first.
     fn sorted_columns(&self, t: usize, cols: &mut [Int], order: &mut [u8]) {
-        let nodes = &self.dofs.tri_nodes[t];
         let global = |k: usize| {
-            if k < 12 {
-                self.dofs.node_global[nodes[k / 2] as usize] + k % 2
-            } else {
-                self.dofs.node_global[nodes[k - 12] as usize] + 2
-            }
+            let (node, c) = self.element_dof(t, k);
+            self.dofs.node_global[node] + c
         };
         let n = self.dofs_per_element;
         let mut keyed = [(0usize, 0u8); 15];
@@ -483,18 +485,15 @@ impl<'a> StepProblem<'a> {
 
     /// Whether element dof `k` of triangle `t` is a prescribed displacement (owned or not).
     fn constrained_column(&self, t: usize, k: usize) -> bool {
-        k < 12 && {
-            let node = self.dofs.tri_nodes[t][k / 2] as usize;
-            self.setup.constraints.is_fixed(node, k % 2)
-        }
+        let (node, c) = self.element_dof(t, k);
+        self.setup.constraints.is_fixed(node, c)
     }
 
     /// The owned, unconstrained row of element dof `k` of triangle `t`, as an offset among this
     /// rank's owned rows, if any.
     fn free_row(&self, t: usize, k: usize) -> Option<usize> {
-        let node = self.dofs.tri_nodes[t][if k < 12 { k / 2 } else { k - 12 }] as usize;
-        let c = if k < 12 { k % 2 } else { 2 };
-        if !self.dofs.node_owned[node] || (c < 2 && self.setup.constraints.is_fixed(node, c)) {
+        let (node, c) = self.element_dof(t, k);
+        if !self.dofs.node_owned[node] || self.setup.constraints.is_fixed(node, c) {
             return None;
         }
         Some(self.dofs.node_global[node] - self.dofs.first_dof + c)
