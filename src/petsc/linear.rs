@@ -218,6 +218,33 @@ impl LinearSolver<'_> {
         }
     }
 
+    /// Whether the fine level's smoother is Richardson–Jacobi damped by the Jacobian's
+    /// spectral bound ([`crate::solve::smoother`]): on the p-multigrid with a symmetric
+    /// tangent, unless the command line names the smoother, its preconditioner or its damping
+    /// (`-mg_levels_ksp_type`, `-mg_levels_pc_type` other than jacobi,
+    /// `-mg_levels_ksp_richardson_scale`, or the same with `mg_levels_1_`). Against Chebyshev
+    /// with its eigenvalue estimate, this drops six vectors of the fine level and the
+    /// estimate's ten matrix products per Newton iteration.
+    pub fn damps_jacobi_smoother(&self) -> Result<bool, PetscError> {
+        let LinearSolver::PMultigrid { symmetric, .. } = self else {
+            return Ok(false);
+        };
+        if !*symmetric {
+            return Ok(false);
+        }
+        for prefix in ["-mg_levels_", "-mg_levels_1_"] {
+            for name in ["ksp_type", "ksp_richardson_scale"] {
+                if option_string(&format!("{prefix}{name}"))?.is_some() {
+                    return Ok(false);
+                }
+            }
+            if option_string(&format!("{prefix}pc_type"))?.is_some_and(|pc| pc != "jacobi") {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
+
     /// Collective. Configures `ksp` (borrowed from a SNES).
     pub(crate) fn configure(&self, ksp: ffi::KSP) -> Result<(), PetscError> {
         let mut pc: ffi::PC = std::ptr::null_mut();
@@ -340,12 +367,23 @@ impl LinearSolver<'_> {
                         ffi::PCGAMGSetUseSAEstEig(coarse_pc, ffi::PetscBool_PETSC_FALSE),
                         "PCGAMGSetUseSAEstEig",
                     )?;
-                    // Chebyshev with point Jacobi on P2 (PCMG's default smoother is
-                    // Chebyshev with SOR), one sweep before and after (two took 30 % longer
-                    // for 3 % fewer iterations), its eigenvalue estimate by CG where the
-                    // tangent is symmetric (GMRES's default keeps 30 vectors).
+                    // Point Jacobi on P2 (PCMG's default smoother is Chebyshev with SOR),
+                    // one sweep before and after (two took 30 % longer for 3 % fewer
+                    // iterations). Where the tangent is symmetric, Richardson damped by the
+                    // Jacobian's own spectral bound (`Snes` sets the damping after every
+                    // Jacobian: `super::snes`, `crate::solve::smoother`); elsewhere
+                    // Chebyshev, its eigenvalues estimated by GMRES (by CG if the user asks
+                    // for Chebyshev on a symmetric tangent: GMRES keeps 30 vectors).
                     default_option("-mg_levels_pc_type", "jacobi")?;
                     default_option("-mg_levels_ksp_max_it", "1")?;
+                    if self.damps_jacobi_smoother()? {
+                        let mut smoother: ffi::KSP = std::ptr::null_mut();
+                        check(
+                            ffi::PCMGGetSmoother(pc, 1, &mut smoother),
+                            "PCMGGetSmoother",
+                        )?;
+                        set_ksp_type(smoother, "richardson")?;
+                    }
                     if *symmetric {
                         default_option("-mg_levels_esteig_ksp_type", "cg")?;
                         // Likewise the coarse GAMG's Chebyshev smoothers: their estimators'

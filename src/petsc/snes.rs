@@ -26,6 +26,12 @@ pub trait NonlinearProblem {
     fn residual(&mut self, x: VecRef<'_>, f: VecRef<'_>) -> Result<(), CallbackError>;
     /// Collective. Consistent tangent dF/dx at `x` into `j` (assembled on return).
     fn jacobian(&mut self, x: VecRef<'_>, j: MatRef<'_>) -> Result<(), CallbackError>;
+    /// The Richardson damping of one Jacobi sweep on the last Jacobian, the same on every
+    /// rank, where the problem knows a bound on its spectrum: the p-multigrid's smoother
+    /// ([`LinearSolver::damps_jacobi_smoother`]) then needs no eigenvalue estimate.
+    fn smoother_damping(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// Newton's outcome.
@@ -40,6 +46,9 @@ pub struct SolveStats {
 pub struct Snes {
     raw: ffi::SNES,
     reuse: Option<FactorReuse>,
+    /// The p-multigrid's fine smoother takes its damping from each Jacobian's spectral bound
+    /// ([`LinearSolver::damps_jacobi_smoother`]).
+    damped_smoother: bool,
 }
 
 struct Ctx<'a> {
@@ -48,6 +57,7 @@ struct Ctx<'a> {
     reuse: Option<FactorReuse>,
     /// The residual norm at the last Jacobian of this solve.
     last_norm: Option<f64>,
+    damped_smoother: bool,
 }
 
 const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
@@ -79,7 +89,11 @@ impl Snes {
                 LinearSolver::Direct { reuse, .. } => *reuse,
                 _ => None,
             };
-            let snes = Snes { raw, reuse };
+            let snes = Snes {
+                raw,
+                reuse,
+                damped_smoother: linear.damps_jacobi_smoother()?,
+            };
             check(
                 ffi::SNESSetTolerances(
                     raw,
@@ -150,6 +164,7 @@ impl Snes {
             error: None,
             reuse: self.reuse,
             last_norm: None,
+            damped_smoother: self.damped_smoother,
         };
         let ctx_ptr = &mut ctx as *mut Ctx as *mut c_void;
         // SAFETY: ctx outlives SNESSolve, the only place the callbacks run; the callbacks catch
@@ -335,6 +350,21 @@ unsafe extern "C" fn jacobian_cb(
     if code != 0 {
         return code;
     }
+    if ctx.damped_smoother {
+        let damped = match ctx.problem.smoother_damping() {
+            Some(damping) => damp_smoother(snes, damping),
+            None => Err(PetscError {
+                code: PETSC_ERR_USER,
+                message: "the p-multigrid's Jacobi smoother needs a spectral bound that this \
+                          Jacobian did not give"
+                    .into(),
+            }),
+        };
+        if let Err(e) = damped {
+            ctx_note(ctx, Some(()), &e.to_string());
+            return PETSC_ERR_USER;
+        }
+    }
     match ctx.reuse {
         Some(reuse) => match choose_factorisation(snes, &reuse, &mut ctx.last_norm) {
             Ok(()) => 0,
@@ -344,6 +374,24 @@ unsafe extern "C" fn jacobian_cb(
             }
         },
         None => 0,
+    }
+}
+
+/// Sets the Richardson damping of the p-multigrid's fine smoother (level 1) for the next
+/// linear solve.
+fn damp_smoother(snes: ffi::SNES, damping: f64) -> Result<(), PetscError> {
+    let mut ksp: ffi::KSP = std::ptr::null_mut();
+    let mut pc: ffi::PC = std::ptr::null_mut();
+    let mut smoother: ffi::KSP = std::ptr::null_mut();
+    // SAFETY: the SNES is live during its callback; KSP, PC and smoother are borrowed from it.
+    unsafe {
+        check(ffi::SNESGetKSP(snes, &mut ksp), "SNESGetKSP")?;
+        check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
+        check(ffi::PCMGGetSmoother(pc, 1, &mut smoother), "PCMGGetSmoother")?;
+        check(
+            ffi::KSPRichardsonSetScale(smoother, damping),
+            "KSPRichardsonSetScale",
+        )
     }
 }
 

@@ -6,6 +6,7 @@ pub mod dofs;
 pub mod nullspace;
 pub mod pmg;
 pub mod problem;
+pub mod smoother;
 pub mod split;
 
 pub use constraints::Constraints;

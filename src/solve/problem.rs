@@ -4,6 +4,7 @@
 //! same order whatever the partition.
 
 use super::pmg::CoarseSpace;
+use super::smoother::{element_jacobi_bound, jacobi_damping};
 use super::{Constraints, DofMap};
 use crate::fem::element::p2_element_with;
 use crate::fem::mixed::p2p1_element;
@@ -96,6 +97,9 @@ pub struct StepProblem<'a> {
     schur: Option<SchurPreconditioner<'a>>,
     /// Where the Jacobian also assembles the p-multigrid's coarse operator.
     coarse: Option<CoarseOperator<'a>>,
+    /// With the coarse operator, the last Jacobian's bound on the spectrum of diag(J)⁻¹J
+    /// ([`super::smoother`]), the same on every rank.
+    jacobi_bound: Cell<Option<f64>>,
     /// The element results of the last residual and the local vector they belong to. SNES asks
     /// for the Jacobian at the iterate whose residual it has just evaluated, and the converged
     /// state is read at the last residual's iterate: each evaluation there was a second full
@@ -150,6 +154,7 @@ impl<'a> StepProblem<'a> {
             diagonal: Cell::new(None),
             schur: None,
             coarse: None,
+            jacobi_bound: Cell::new(None),
             cache: RefCell::new(None),
             keep_elements: true,
         })
@@ -745,6 +750,10 @@ impl NonlinearProblem for StepProblem<'_> {
         Ok(())
     }
 
+    fn smoother_damping(&self) -> Option<f64> {
+        self.jacobi_bound.get().map(jacobi_damping)
+    }
+
     fn jacobian(&mut self, x: VecRef<'_>, j: MatRef<'_>) -> Result<(), CallbackError> {
         let fatal = |e: PetscError| CallbackError::Fatal(e.to_string());
         j.zero_entries().map_err(fatal)?;
@@ -758,6 +767,8 @@ impl NonlinearProblem for StepProblem<'_> {
         let mut rows = Vec::new();
         let mut vals = Vec::new();
         let (mut sorted_cols, mut sorted_dofs) = ([0 as Int; 15], [0u8; 15]);
+        let mut jacobi_bound: f64 = 0.0;
+        let bounded = self.bounds_jacobi_spectrum();
         let evaluated = self.evaluate(x, true, |t, e| {
             if let Some(c) = &self.coarse {
                 let m = c.matrix.as_ref();
@@ -791,6 +802,9 @@ impl NonlinearProblem for StepProblem<'_> {
             let fixed = (0..n)
                 .filter(|&k| self.constrained_column(t, k))
                 .fold(0u16, |m, k| m | 1 << k);
+            if bounded {
+                jacobi_bound = jacobi_bound.max(element_jacobi_bound(&e.tangent, n, fixed));
+            }
             let push_row = |vals: &mut Vec<f64>, k: usize| {
                 let row = &e.tangent[k * n..][..n];
                 if fixed == 0 {
@@ -855,6 +869,11 @@ impl NonlinearProblem for StepProblem<'_> {
             }
             Err(e) => return Err(e),
         };
+        if bounded {
+            // A prescribed row holds only its diagonal: eigenvalue 1 of diag(J)⁻¹J.
+            let bound = pfem_partition::max_f64(self.comm, jacobi_bound.max(1.0));
+            self.jacobi_bound.set(Some(bound));
+        }
         self.external_tangent(&local, |r, c, v| j.add_values(&[r], &[c], &[v]))
             .map_err(fatal)?;
         let diagonal = self.constrained_diagonal();
@@ -877,6 +896,13 @@ impl NonlinearProblem for StepProblem<'_> {
 }
 
 impl StepProblem<'_> {
+    /// Whether the Jacobian bounds the spectrum of diag(J)⁻¹J (for the p-multigrid's smoother):
+    /// where the tangent is the sum of the element tangents alone. Contact and follower
+    /// pressures add terms that are neither element matrices nor symmetric.
+    fn bounds_jacobi_spectrum(&self) -> bool {
+        self.coarse.is_some() && self.setup.contact.is_empty() && self.setup.surface.is_empty()
+    }
+
     /// Collective. Gives the prescribed coarse rows the mean free coarse diagonal (from this
     /// rank's sum of its free diagonal entries) and assembles the coarse operator. Contact and
     /// follower pressures stay on the fine level: their terms couple a node, or a boundary
