@@ -10,6 +10,7 @@ pub mod matrix;
 pub mod nullspace;
 pub mod reason;
 pub mod scatter;
+pub mod shell;
 pub mod snes;
 pub mod vector;
 
@@ -30,5 +31,6 @@ pub use matrix::{Mat, MatRef};
 pub use nullspace::NullSpace;
 pub use reason::{Divergence, KspDiverged, SnesDiverged, SolveFailure};
 pub use scatter::Scatter;
+pub use shell::LinearOperator;
 pub use snes::{NonlinearProblem, Snes, SolveStats};
 pub use vector::{PVec, VecRef};

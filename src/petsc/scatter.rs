@@ -80,6 +80,41 @@ impl Scatter {
     }
 }
 
+impl Scatter {
+    /// Collective. The reverse of [`Self::gather`]: `f` fills one value per local entry, which
+    /// is added to its global entry of `into` (several ranks may add to one entry).
+    pub fn add_back(
+        &self,
+        into: VecRef<'_>,
+        f: impl FnOnce(&mut [super::Scalar]),
+    ) -> Result<(), PetscError> {
+        self.local.as_ref().write(f)?;
+        // SAFETY: both vectors are live and match the layouts the scatter was built for.
+        unsafe {
+            check(
+                ffi::VecScatterBegin(
+                    self.raw,
+                    self.local.raw,
+                    into.raw,
+                    ffi::InsertMode_ADD_VALUES,
+                    ffi::ScatterMode_SCATTER_REVERSE,
+                ),
+                "VecScatterBegin",
+            )?;
+            check(
+                ffi::VecScatterEnd(
+                    self.raw,
+                    self.local.raw,
+                    into.raw,
+                    ffi::InsertMode_ADD_VALUES,
+                    ffi::ScatterMode_SCATTER_REVERSE,
+                ),
+                "VecScatterEnd",
+            )
+        }
+    }
+}
+
 impl Drop for Scatter {
     fn drop(&mut self) {
         // SAFETY: we own the scatter.

@@ -6,12 +6,12 @@ use crate::mapping::{recover_at_particles, StartStates, TriStates};
 use crate::material::GaussState;
 use crate::mesh::LocalMesh;
 use crate::petsc::linear::{p_multigrid_from_options, upper_triangle_smoother_from_options};
-use crate::petsc::matrix::{to_int, to_ints};
 use crate::petsc::{
     IndexSet, LinearSolver, Mat, NullSpace, PVec, Petsc, PetscError, Snes, SolveFailure,
 };
 use crate::scene::{LineSearch, LinearChoice};
 use crate::solve::nullspace::orthonormal_rigid_body_modes;
+use crate::solve::interpolation::{Interpolation, InterpolationMap};
 use crate::solve::pmg::CoarseSpace;
 use crate::solve::{
     CoarseOperator, Constraints, DofMap, FieldLayout, SchurPreconditioner, StepProblem, StepSetup,
@@ -40,8 +40,9 @@ impl SolverObjects {
 }
 
 /// The coarse level of the two-level p-multigrid (iterative P2 path, `-pfem_pmg`): the
-/// interpolation and the near-null space are filled at every increment's start (its geometry
-/// and constraints), the coarse operator at every Jacobian (the tangent's Galerkin product).
+/// interpolation (an operator, [`Interpolation`]) and the near-null space are made at every
+/// increment's start (its geometry and constraints), the coarse operator at every Jacobian
+/// (the tangent's Galerkin product).
 struct PMultigrid {
     space: CoarseSpace,
     interpolation: Mat,
@@ -248,7 +249,7 @@ impl Simulation {
             surface: loads.surface,
         };
         let mut cache = self
-            .solver_objects(world, mesh, &dofs)
+            .solver_objects(world, mesh, &dofs, &constraints)
             .map_err(|e| err(e.to_string()))?;
         let outcome = self.solve_with(
             world, mesh, &dofs, setup, &spacing, &mut cache, scale, from, step,
@@ -279,12 +280,13 @@ impl Simulation {
 
     /// Collective. The vector, matrix and SNES for `dofs`: last increment's when the matrix
     /// pattern is the same on every rank (PETSc then keeps the symbolic factorisation), new ones
-    /// otherwise.
+    /// otherwise (always for an iterative solver, whose interpolation follows `constraints`).
     fn solver_objects(
         &self,
         world: &Comm,
         mesh: &LocalMesh,
         dofs: &DofMap,
+        constraints: &Constraints,
     ) -> Result<SolverObjects, crate::petsc::PetscError> {
         // A different line search is a different SNES.
         let alternate = self.alternate_search.get();
@@ -341,8 +343,9 @@ impl Simulation {
                 message: e.to_string(),
             })?;
             let interpolation = {
-                let (d_nnz, o_nnz) = CoarseSpace::interpolation_preallocation(dofs);
-                Mat::aij_rect(world, [dofs.n_owned_dofs, space.n_owned], 2, &d_nnz, &o_nnz)?
+                let map = InterpolationMap::new(dofs, constraints, &space);
+                let op = Interpolation::new(world, map)?;
+                Mat::shell(world, [dofs.n_owned_dofs, space.n_owned], Box::new(op))?
             };
             let coarse = {
                 let (d_nnz, o_nnz) = CoarseSpace::operator_preallocation(dofs);
@@ -491,7 +494,7 @@ impl Simulation {
             ..
         } = objects;
         if let Some(m) = pmg {
-            fill_p_multigrid(world, mesh, dofs, &setup, m).map_err(err)?;
+            fill_p_multigrid(world, mesh, dofs, m).map_err(err)?;
         }
         let mut problem =
             StepProblem::new(world, mesh, dofs, setup, x).map_err(|e| err(e.to_string()))?;
@@ -851,33 +854,16 @@ fn owned_area(mesh: &LocalMesh, du: &[[f64; 2]], dofs: &DofMap) -> f64 {
     area
 }
 
-/// Collective. The p-multigrid's interpolation for this increment (start-of-step geometry and
-/// constraints) and its coarse level's rigid-body near-null space; the coarse operator itself
-/// is assembled with every Jacobian ([`CoarseOperator`]).
+/// Collective. The p-multigrid coarse level's rigid-body near-null space for this increment
+/// (start-of-step geometry); the interpolation is made with the solver objects, and the coarse
+/// operator is assembled with every Jacobian ([`CoarseOperator`]).
 fn fill_p_multigrid(
     world: &Comm,
     mesh: &LocalMesh,
     dofs: &DofMap,
-    setup: &StepSetup,
     m: &PMultigrid,
 ) -> Result<(), String> {
     let petsc = |e: PetscError| e.to_string();
-    let p = m.interpolation.as_ref();
-    p.zero_entries().map_err(petsc)?;
-    // Rank-local insertions; a failure on any rank is agreed on before the collective
-    // assembly, so that no rank waits in it alone.
-    let local = m.space.interpolation(dofs, setup.constraints, |r, c, w| {
-        p.add_values(&[to_int(r, "dof")?], &to_ints(c, "dof")?, w)
-    });
-    let failed = sum_f64(world, &[if local.is_err() { 1.0 } else { 0.0 }])[0];
-    match local {
-        Err(e) => return Err(e.to_string()),
-        Ok(()) if failed > 0.0 => {
-            return Err("the p-multigrid's interpolation failed on another rank".into())
-        }
-        Ok(()) => {}
-    }
-    p.assemble().map_err(petsc)?;
     let modes = orthonormal_rigid_body_modes(world, &m.space.coordinates(mesh, dofs));
     // The matrix holds its own reference to the space.
     let space = NullSpace::new(world, m.space.n_owned, &modes).map_err(petsc)?;

@@ -3,6 +3,7 @@
 
 pub mod constraints;
 pub mod dofs;
+pub mod interpolation;
 pub mod nullspace;
 pub mod pmg;
 pub mod problem;

@@ -15,12 +15,14 @@ use crate::fem::p2::EDGES;
 use crate::mesh::LocalMesh;
 use pfem_partition::{allgather_u64, exscan_u64, Comm, PartitionError};
 
-/// The P1 space on this rank: its numbering. The interpolation's and coarse operator's
-/// preallocations are made on demand ([`Self::interpolation_preallocation`],
-/// [`Self::operator_preallocation`]).
+/// The P1 space on this rank: its numbering. The coarse operator's preallocation is made on
+/// demand ([`Self::operator_preallocation`]); the interpolation is an operator
+/// ([`super::interpolation`]).
 pub struct CoarseSpace {
     /// Owned coarse dofs (2 per owned vertex node).
     pub n_owned: usize,
+    /// The global number of this rank's first coarse dof.
+    pub first: usize,
     /// Per local vertex node (the first nodes of the dof map): the global number of its coarse
     /// x dof (y follows).
     coarse_dof: Vec<usize>,
@@ -47,29 +49,14 @@ impl CoarseSpace {
             .collect();
         Ok(CoarseSpace {
             n_owned: 2 * owned_vertices,
+            first: coarse_first as usize,
             coarse_dof,
         })
     }
 
-    /// Per owned P2 row of the interpolation, its nonzeros in owned and in other ranks'
-    /// columns. Made on demand and dropped once the matrix is preallocated: kept, the counts of
-    /// both matrices would sit under the memory peak of every Newton iteration.
-    pub fn interpolation_preallocation(dofs: &DofMap) -> (Vec<usize>, Vec<usize>) {
-        let (mut d_nnz, mut o_nnz) = (Vec::new(), Vec::new());
-        for n in (0..dofs.n_nodes()).filter(|&n| dofs.node_owned[n]) {
-            let ends = interpolation_ends(dofs, n);
-            let inside = ends.iter().filter(|&&(v, _)| dofs.node_owned[v]).count();
-            // One entry per end: a component interpolates from the same component.
-            for _ in 0..2 {
-                d_nnz.push(inside);
-                o_nnz.push(ends.len() - inside);
-            }
-        }
-        (d_nnz, o_nnz)
-    }
-
     /// Per owned coarse row of the coarse operator, its nonzeros in owned and in other ranks'
-    /// columns (made on demand, as [`Self::interpolation_preallocation`]).
+    /// columns. Made on demand and dropped once the matrix is preallocated: kept, the counts
+    /// would sit under the memory peak of every Newton iteration.
     pub fn operator_preallocation(dofs: &DofMap) -> (Vec<usize>, Vec<usize>) {
         let (mut d_nnz, mut o_nnz) = (Vec::new(), Vec::new());
         for (owned, other) in dofs.vertex_neighbour_counts() {
@@ -81,30 +68,9 @@ impl CoarseSpace {
         (d_nnz, o_nnz)
     }
 
-    /// Hands `add` the interpolation's entries on this rank's P2 rows, one row at a time
-    /// (global row, global columns, weights). Entries of prescribed P2 rows and of prescribed
-    /// coarse columns are zero (kept, so that the pattern does not depend on the constraints):
-    /// a coarse correction never moves a prescribed dof, and the residual at one never reaches
-    /// the coarse level.
-    pub fn interpolation<E>(
-        &self,
-        dofs: &DofMap,
-        constraints: &Constraints,
-        mut add: impl FnMut(usize, &[usize], &[f64]) -> Result<(), E>,
-    ) -> Result<(), E> {
-        let fixed = |n: usize, c: usize| constraints.is_fixed(n, c);
-        for n in (0..dofs.n_nodes()).filter(|&n| dofs.node_owned[n]) {
-            let ends = interpolation_ends(dofs, n);
-            for c in 0..2 {
-                let cols: Vec<usize> = ends.iter().map(|&(v, _)| self.coarse_dof[v] + c).collect();
-                let weights: Vec<f64> = ends
-                    .iter()
-                    .map(|&(v, w)| if fixed(n, c) || fixed(v, c) { 0.0 } else { w })
-                    .collect();
-                add(dofs.node_global[n] + c, &cols, &weights)?;
-            }
-        }
-        Ok(())
+    /// The global coarse x dof of local vertex node `v` (y follows).
+    pub fn coarse_dof(&self, v: usize) -> usize {
+        self.coarse_dof[v]
     }
 
     /// Hands `add` the Galerkin coarse operator Rᵀ K R of triangle `t` whose P2 tangent is `k`
@@ -243,7 +209,7 @@ fn n_vertex_nodes(dofs: &DofMap) -> usize {
 }
 
 /// The vertex nodes node `n` interpolates from, with their weights.
-fn interpolation_ends(dofs: &DofMap, n: usize) -> Vec<(usize, f64)> {
+pub(super) fn interpolation_ends(dofs: &DofMap, n: usize) -> Vec<(usize, f64)> {
     let n_vertex = n_vertex_nodes(dofs);
     if n < n_vertex {
         return vec![(n, 1.0)];

@@ -1,0 +1,166 @@
+//! The p-multigrid's P1 → P2 interpolation applied instead of stored (a PETSc shell matrix):
+//! a vertex node takes its own coarse value, a midside node the mean of its edge's ends. As an
+//! AIJ matrix it held 2 rows a node with their column indices, about 200 bytes a particle on
+//! one rank; here it is two coarse slots and a mask a node (9 bytes). Every sum runs in the
+//! order PETSc's AIJ product ran it (owned columns, then ghosts, each by global number), so
+//! the results are bit for bit those of the stored matrix.
+
+use super::pmg::{interpolation_ends, CoarseSpace};
+use super::{Constraints, DofMap};
+use crate::petsc::{LinearOperator, PVec, PetscError, Scalar, Scatter, VecRef};
+use pfem_partition::Comm;
+
+/// No second end: a vertex node.
+const NONE: u32 = u32::MAX;
+
+/// The numbers of the interpolation on this rank, without PETSc: for the operator and its tests.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InterpolationMap {
+    /// Per owned fine node, in the order of its dofs: the coarse slots of the x dofs of the
+    /// vertices it interpolates from (y follows), ascending; the second is [`NONE`] at a
+    /// vertex node. Slots below `n_owned_coarse` are this rank's coarse dofs in order, the
+    /// others its ghost vertices' (by global number).
+    ends: Vec<[u32; 2]>,
+    /// Per owned fine node, bit 2 e + c: end e reaches component c (the fine dof and the
+    /// end's coarse dof are both free; a prescribed dof takes no coarse correction and gives
+    /// the coarse level no residual).
+    live: Vec<u8>,
+    n_owned_coarse: usize,
+    /// The global coarse dofs of the ghost slots, in slot order.
+    ghost_dofs: Vec<usize>,
+}
+
+impl InterpolationMap {
+    /// Relies on [`DofMap`] giving every owned node 2 consecutive dofs in the rank's range.
+    pub fn new(dofs: &DofMap, constraints: &Constraints, space: &CoarseSpace) -> InterpolationMap {
+        let owned: Vec<usize> = (0..dofs.n_nodes()).filter(|&n| dofs.node_owned[n]).collect();
+        let mut ghosts: Vec<usize> = owned
+            .iter()
+            .flat_map(|&n| interpolation_ends(dofs, n))
+            .map(|(v, _)| v)
+            .filter(|&v| !dofs.node_owned[v])
+            .map(|v| space.coarse_dof(v))
+            .collect();
+        ghosts.sort_unstable();
+        ghosts.dedup();
+        let n_owned_coarse = space.n_owned;
+        let slot = |v: usize| {
+            let g = space.coarse_dof(v);
+            let s = if dofs.node_owned[v] {
+                g - space.first
+            } else {
+                n_owned_coarse + 2 * ghosts.binary_search(&g).expect("collected above")
+            };
+            u32::try_from(s).expect("coarse slots fit in 32 bits")
+        };
+        let mut ends = vec![[NONE; 2]; dofs.n_owned_dofs / 2];
+        let mut live = vec![0u8; ends.len()];
+        for &n in &owned {
+            let i = (dofs.node_global[n] - dofs.first_dof) / 2;
+            let mut by_slot: Vec<(u32, usize)> = interpolation_ends(dofs, n)
+                .into_iter()
+                .map(|(v, _)| (slot(v), v))
+                .collect();
+            by_slot.sort_unstable();
+            for (e, &(s, v)) in by_slot.iter().enumerate() {
+                ends[i][e] = s;
+                for c in 0..2 {
+                    if !constraints.is_fixed(n, c) && !constraints.is_fixed(v, c) {
+                        live[i] |= 1 << (2 * e + c);
+                    }
+                }
+            }
+        }
+        let ghost_dofs = ghosts.iter().flat_map(|&g| [g, g + 1]).collect();
+        InterpolationMap {
+            ends,
+            live,
+            n_owned_coarse,
+            ghost_dofs,
+        }
+    }
+
+    /// fine = P coarse, or fine + P coarse with `add`; `own` and `ghost` are the coarse values
+    /// of the owned and ghost slots.
+    pub fn prolong(&self, own: &[f64], ghost: &[f64], fine: &mut [f64], add: bool) {
+        let value = |s: usize| {
+            if s < self.n_owned_coarse {
+                own[s]
+            } else {
+                ghost[s - self.n_owned_coarse]
+            }
+        };
+        for (i, (ends, &live)) in self.ends.iter().zip(&self.live).enumerate() {
+            let w = if ends[1] == NONE { 1.0 } else { 0.5 };
+            for c in 0..2 {
+                let mut sum = if add { fine[2 * i + c] } else { 0.0 };
+                for (e, &s) in ends.iter().enumerate() {
+                    if live & 1 << (2 * e + c) != 0 {
+                        sum += w * value(s as usize + c);
+                    }
+                }
+                fine[2 * i + c] = sum;
+            }
+        }
+    }
+
+    /// (own, ghost) = Pᵀ fine, the ghost slots' sums still to be added on their owners.
+    pub fn restrict(&self, fine: &[f64], own: &mut [f64], ghost: &mut [f64]) {
+        own.fill(0.0);
+        ghost.fill(0.0);
+        for (i, (ends, &live)) in self.ends.iter().zip(&self.live).enumerate() {
+            let w = if ends[1] == NONE { 1.0 } else { 0.5 };
+            for c in 0..2 {
+                let y = fine[2 * i + c];
+                for (e, &s) in ends.iter().enumerate() {
+                    if live & 1 << (2 * e + c) != 0 {
+                        let s = s as usize + c;
+                        if s < self.n_owned_coarse {
+                            own[s] += w * y;
+                        } else {
+                            ghost[s - self.n_owned_coarse] += w * y;
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The interpolation as a PETSc operator: the map and the scatter of its coarse ghosts.
+pub struct Interpolation {
+    map: InterpolationMap,
+    ghosts: Scatter,
+}
+
+impl Interpolation {
+    /// Collective (builds the scatter of the coarse ghosts).
+    pub fn new(comm: &Comm, map: InterpolationMap) -> Result<Interpolation, PetscError> {
+        let template = PVec::mpi(comm, map.n_owned_coarse)?;
+        let ghosts = Scatter::new(&template, &map.ghost_dofs)?;
+        Ok(Interpolation { map, ghosts })
+    }
+
+    /// Collective.
+    fn prolong(&self, x: VecRef<'_>, y: VecRef<'_>, add: bool) -> Result<(), PetscError> {
+        self.ghosts.gather(x, |ghost: &[Scalar]| {
+            x.read(|own| y.write(|fine| self.map.prolong(own, ghost, fine, add)))
+        })??
+    }
+}
+
+impl LinearOperator for Interpolation {
+    fn mult(&self, x: VecRef<'_>, y: VecRef<'_>) -> Result<(), PetscError> {
+        self.prolong(x, y, false)
+    }
+
+    fn mult_add(&self, x: VecRef<'_>, y: VecRef<'_>) -> Result<(), PetscError> {
+        self.prolong(x, y, true)
+    }
+
+    fn mult_transpose(&self, y: VecRef<'_>, x: VecRef<'_>) -> Result<(), PetscError> {
+        let mut ghost = vec![0.0; self.map.ghost_dofs.len()];
+        y.read(|fine| x.write(|own| self.map.restrict(fine, own, &mut ghost)))??;
+        self.ghosts.add_back(x, |g| g.copy_from_slice(&ghost))
+    }
+}
