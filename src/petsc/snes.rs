@@ -387,7 +387,10 @@ fn damp_smoother(snes: ffi::SNES, damping: f64) -> Result<(), PetscError> {
     unsafe {
         check(ffi::SNESGetKSP(snes, &mut ksp), "SNESGetKSP")?;
         check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
-        check(ffi::PCMGGetSmoother(pc, 1, &mut smoother), "PCMGGetSmoother")?;
+        check(
+            ffi::PCMGGetSmoother(pc, 1, &mut smoother),
+            "PCMGGetSmoother",
+        )?;
         check(
             ffi::KSPRichardsonSetScale(smoother, damping),
             "KSPRichardsonSetScale",

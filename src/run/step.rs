@@ -10,8 +10,8 @@ use crate::petsc::{
     IndexSet, LinearSolver, Mat, NullSpace, PVec, Petsc, PetscError, Snes, SolveFailure,
 };
 use crate::scene::{LineSearch, LinearChoice};
-use crate::solve::nullspace::orthonormal_rigid_body_modes;
 use crate::solve::interpolation::{Interpolation, InterpolationMap};
+use crate::solve::nullspace::orthonormal_rigid_body_modes;
 use crate::solve::pmg::CoarseSpace;
 use crate::solve::{
     CoarseOperator, Constraints, DofMap, FieldLayout, SchurPreconditioner, StepProblem, StepSetup,

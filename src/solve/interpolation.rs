@@ -33,7 +33,9 @@ pub struct InterpolationMap {
 impl InterpolationMap {
     /// Relies on [`DofMap`] giving every owned node 2 consecutive dofs in the rank's range.
     pub fn new(dofs: &DofMap, constraints: &Constraints, space: &CoarseSpace) -> InterpolationMap {
-        let owned: Vec<usize> = (0..dofs.n_nodes()).filter(|&n| dofs.node_owned[n]).collect();
+        let owned: Vec<usize> = (0..dofs.n_nodes())
+            .filter(|&n| dofs.node_owned[n])
+            .collect();
         let mut ghosts: Vec<usize> = owned
             .iter()
             .flat_map(|&n| interpolation_ends(dofs, n))
@@ -162,5 +164,87 @@ impl LinearOperator for Interpolation {
         let mut ghost = vec![0.0; self.map.ghost_dofs.len()];
         y.read(|fine| x.write(|own| self.map.restrict(fine, own, &mut ghost)))??;
         self.ghosts.add_back(x, |g| g.copy_from_slice(&ghost))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_map_orders_ends_as_petsc_did_and_masks_prescribed_components() {
+        // A rank owning vertices 0 and 1 and the midside nodes of edges (0, 1) and (0, 2);
+        // vertex 2 and edge (1, 2) are another rank's. Coarse numbers run against the local
+        // order; x is prescribed at points 1 and 2.
+        let dofs = DofMap {
+            node_of_point: vec![0, 1, 2],
+            edges: vec![[0, 1], [1, 2], [0, 2]],
+            tri_nodes: vec![[0, 1, 2, 3, 4, 5]],
+            node_global: vec![100, 102, 0, 104, 2, 106],
+            node_local: vec![0, 2, 4, 6, 8, 10],
+            vertex_dofs: 2,
+            node_owned: vec![true, true, false, true, false, true],
+            node_point: vec![0, 1, 2, u32::MAX, u32::MAX, u32::MAX],
+            n_owned_dofs: 8,
+            first_dof: 100,
+            n_global_dofs: 112,
+        };
+        let space = CoarseSpace::for_tests(4, 50, vec![52, 50, 10]);
+        let constraints =
+            Constraints::build(&dofs, |p| [if p == 0 { None } else { Some(0.0) }, None]);
+        let map = InterpolationMap::new(&dofs, &constraints, &space);
+        assert_eq!(map.ends, vec![[2, NONE], [0, NONE], [0, 2], [2, 4]]);
+        assert_eq!(map.live, vec![0b11, 0b10, 0b1110, 0b1011]);
+        assert_eq!(
+            (map.n_owned_coarse, map.ghost_dofs.clone()),
+            (4, vec![10, 11])
+        );
+    }
+
+    /// One triangle whose third vertex is a ghost (slot 4 of a rank owning 4 coarse dofs):
+    /// vertex nodes 0, 1, then the edge nodes (0, 1), (1, 2), (0, 2); all dofs free but the
+    /// y of edge node (1, 2), and the ghost vertex's x.
+    fn triangle() -> InterpolationMap {
+        let full = 0b1111;
+        InterpolationMap {
+            ends: vec![[0, NONE], [2, NONE], [0, 2], [2, 4], [0, 4]],
+            live: vec![0b11, 0b11, full, full & !0b1010 & !0b0100, full & !0b0100],
+            n_owned_coarse: 4,
+            ghost_dofs: vec![10, 11],
+        }
+    }
+
+    #[test]
+    fn a_linear_field_is_interpolated_exactly_where_nothing_is_prescribed() {
+        let mut map = triangle();
+        map.live = vec![0b11, 0b11, 0b1111, 0b1111, 0b1111];
+        // u = (1 + x, 2 y) at vertices (0, 0), (1, 0), (0, 1).
+        let (own, ghost) = ([1.0, 0.0, 2.0, 0.0], [1.0, 2.0]);
+        let mut fine = [f64::NAN; 10];
+        map.prolong(&own, &ghost, &mut fine, false);
+        assert_eq!(fine, [1.0, 0.0, 2.0, 0.0, 1.5, 0.0, 1.5, 1.0, 1.0, 1.0]);
+        let mut again = fine;
+        map.prolong(&own, &ghost, &mut again, true);
+        assert_eq!(again, fine.map(|v| 2.0 * v));
+    }
+
+    #[test]
+    fn restriction_is_the_transpose_and_prescribed_dofs_take_no_part() {
+        let map = triangle();
+        let (own, ghost) = ([0.3, -1.7, 2.9, 0.4], [5.0, -0.25]);
+        let fine_y = [0.7, -0.2, 1.3, 2.2, -0.9, 0.6, 1.1, -3.0, 0.05, 0.8];
+        let mut fine = [0.0; 10];
+        map.prolong(&own, &ghost, &mut fine, false);
+        // The y of edge node (1, 2) is prescribed: no coarse correction reaches it.
+        assert_eq!(fine[7], 0.0);
+        // The ghost's x is prescribed: edge (0, 2) takes only half of vertex 0's x.
+        assert_eq!(fine[8], 0.5 * own[0]);
+        let (mut r_own, mut r_ghost) = ([f64::NAN; 4], [f64::NAN; 2]);
+        map.restrict(&fine_y, &mut r_own, &mut r_ghost);
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        let left = dot(&fine, &fine_y);
+        let right = dot(&own, &r_own) + dot(&ghost, &r_ghost);
+        assert!((left - right).abs() < 1e-14, "{left} vs {right}");
+        assert_eq!(r_ghost[0], 0.0);
     }
 }

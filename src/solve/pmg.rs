@@ -68,6 +68,16 @@ impl CoarseSpace {
         (d_nnz, o_nnz)
     }
 
+    /// A space from its numbers, for tests elsewhere.
+    #[cfg(test)]
+    pub(super) fn for_tests(n_owned: usize, first: usize, coarse_dof: Vec<usize>) -> Self {
+        CoarseSpace {
+            n_owned,
+            first,
+            coarse_dof,
+        }
+    }
+
     /// The global coarse x dof of local vertex node `v` (y follows).
     pub fn coarse_dof(&self, v: usize) -> usize {
         self.coarse_dof[v]
@@ -302,6 +312,7 @@ mod tests {
         };
         let space = CoarseSpace {
             n_owned: 6,
+            first: 0,
             coarse_dof: vec![4, 0, 2],
         };
         let constraints = Constraints::build(&dofs, |_| [None, None]);

@@ -26,7 +26,11 @@ pub fn element_jacobi_bound(k: &[f64], n: usize, fixed: u16) -> f64 {
     let mut scale = [0.0; 16];
     for (i, s) in scale.iter_mut().enumerate().take(n) {
         let d = k[i * n + i].abs();
-        *s = if d > 0.0 { 1.0 / d.sqrt() } else { f64::INFINITY };
+        *s = if d > 0.0 {
+            1.0 / d.sqrt()
+        } else {
+            f64::INFINITY
+        };
     }
     let mut bound: f64 = 0.0;
     for i in (0..n).filter(|&i| free(i)) {
@@ -55,7 +59,9 @@ mod tests {
     fn spd(n: usize, seed: u64) -> DMatrix<f64> {
         let mut state = seed;
         let mut next = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
         };
         let a = DMatrix::from_fn(n, n, |_, _| next());
