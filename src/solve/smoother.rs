@@ -22,26 +22,38 @@ pub fn jacobi_damping(bound: f64) -> f64 {
 /// infinity: no damping is safe there.
 pub fn element_jacobi_bound(k: &[f64], n: usize, fixed: u16) -> f64 {
     debug_assert!(n <= 16 && k.len() >= n * n);
-    let free = |i: usize| fixed & 1 << i == 0;
+    // 1/√kᵢᵢ on free dofs, 0 on prescribed ones (their rows and columns take no part).
     let mut scale = [0.0; 16];
     for (i, s) in scale.iter_mut().enumerate().take(n) {
         let d = k[i * n + i].abs();
-        *s = if d > 0.0 {
+        *s = if fixed & 1 << i != 0 {
+            0.0
+        } else if d > 0.0 {
             1.0 / d.sqrt()
         } else {
             f64::INFINITY
         };
     }
-    let mut bound: f64 = 0.0;
-    for i in (0..n).filter(|&i| free(i)) {
-        let row = &k[i * n..][..n];
-        let sum: f64 = (0..n)
-            .filter(|&j| free(j) && row[j] != 0.0)
-            .map(|j| row[j].abs() * scale[i] * scale[j])
-            .sum();
-        bound = bound.max(sum);
+    // Row sums of the scaled |K|, from its upper triangle (K is symmetric).
+    let mut rows = [0.0; 16];
+    for i in 0..n {
+        if scale[i] == 0.0 {
+            continue;
+        }
+        let d = k[i * n + i].abs();
+        if d > 0.0 {
+            rows[i] += d * scale[i] * scale[i];
+        }
+        for j in i + 1..n {
+            let kij = k[i * n + j];
+            if kij != 0.0 && scale[j] != 0.0 {
+                let v = kij.abs() * scale[i] * scale[j];
+                rows[i] += v;
+                rows[j] += v;
+            }
+        }
     }
-    bound
+    rows[..n].iter().fold(0.0, |m: f64, &r| m.max(r))
 }
 
 #[cfg(test)]
