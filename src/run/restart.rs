@@ -70,7 +70,7 @@ impl Simulation {
                 let mut nodes = [f64::NAN; NODE_LEN];
                 for (k, node) in tri_node_keys(key).iter().enumerate() {
                     if let Some(v) = last.get(node) {
-                        nodes[3 * k..3 * k + 3].copy_from_slice(v);
+                        nodes[3 * k..3 * k + 3].copy_from_slice(&v);
                     }
                 }
                 records.nodes.push(nodes);
@@ -126,7 +126,7 @@ impl Simulation {
                 }
             }
         }
-        *self.last_nodes.borrow_mut() = super::node_values::NodeValues::new(last);
+        *self.last_nodes.borrow_mut() = super::node_values::NodeValues::new(last, self.model.mixed());
         let mut touching = self.last_contact.borrow_mut();
         touching.clear();
         for c in chunks() {

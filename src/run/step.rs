@@ -717,7 +717,8 @@ impl Simulation {
             let v = [per_step * d[0], per_step * d[1], solved.pressure[n]];
             (node_key(mesh, &solved.dofs, n), v)
         });
-        *self.last_nodes.borrow_mut() = super::node_values::NodeValues::new(last.collect());
+        *self.last_nodes.borrow_mut() =
+            super::node_values::NodeValues::new(last.collect(), self.model.mixed());
         self.particles.state = recover_at_particles(mesh, &solved.states, &self.particles.state);
         self.tri_states = TriStates::new(mesh, solved.states);
         self.last_reaction = solved.reaction;
