@@ -126,7 +126,8 @@ impl Simulation {
                 }
             }
         }
-        *self.last_nodes.borrow_mut() = super::node_values::NodeValues::new(last, self.model.mixed());
+        *self.last_nodes.borrow_mut() =
+            super::node_values::NodeValues::new(last, self.model.mixed());
         let mut touching = self.last_contact.borrow_mut();
         touching.clear();
         for c in chunks() {

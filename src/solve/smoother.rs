@@ -26,31 +26,27 @@ pub fn element_jacobi_bound(k: &[f64], n: usize, fixed: u16) -> f64 {
     let mut scale = [0.0; 16];
     for (i, s) in scale.iter_mut().enumerate().take(n) {
         let d = k[i * n + i].abs();
-        *s = if fixed & 1 << i != 0 {
-            0.0
-        } else if d > 0.0 {
-            1.0 / d.sqrt()
-        } else {
-            f64::INFINITY
-        };
-    }
-    // Row sums of the scaled |K|, from its upper triangle (K is symmetric).
-    let mut rows = [0.0; 16];
-    for i in 0..n {
-        if scale[i] == 0.0 {
+        if fixed & 1 << i != 0 {
             continue;
         }
-        let d = k[i * n + i].abs();
         if d > 0.0 {
-            rows[i] += d * scale[i] * scale[i];
+            *s = 1.0 / d.sqrt();
+        } else if (0..n).any(|j| j != i && fixed & 1 << j == 0 && k[i * n + j] != 0.0) {
+            return f64::INFINITY;
+        }
+    }
+    // Row sums of the scaled |K| from its upper triangle (K is symmetric); a free row's
+    // diagonal term is 1.
+    let mut rows = [0.0; 16];
+    for i in 0..n {
+        let si = scale[i];
+        if si > 0.0 {
+            rows[i] += 1.0;
         }
         for j in i + 1..n {
-            let kij = k[i * n + j];
-            if kij != 0.0 && scale[j] != 0.0 {
-                let v = kij.abs() * scale[i] * scale[j];
-                rows[i] += v;
-                rows[j] += v;
-            }
+            let v = k[i * n + j].abs() * si * scale[j];
+            rows[i] += v;
+            rows[j] += v;
         }
     }
     rows[..n].iter().fold(0.0, |m: f64, &r| m.max(r))
