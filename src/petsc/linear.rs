@@ -35,8 +35,10 @@ pub enum LinearSolver<'a> {
     /// displacements equal to 1e-15.
     Amg { rtol: Scalar, symmetric: bool },
     /// As [`LinearSolver::Amg`], preconditioned by a two-level p-multigrid instead of GAMG on
-    /// the P2 system: one Chebyshev–Jacobi sweep before and after on P2, `interpolation` from
-    /// P1 on the particles, and two GAMG cycles (Richardson) on `coarse`, the Galerkin product
+    /// the P2 system: one Jacobi sweep before and after on P2 (Richardson damped by the
+    /// Jacobian's spectral bound where the tangent is symmetric,
+    /// [`LinearSolver::damps_jacobi_smoother`]; Chebyshev elsewhere), `interpolation` (a shell
+    /// operator) from P1 on the particles, and two GAMG cycles (Richardson) on `coarse`, the Galerkin product
     /// of the element tangents that every Jacobian assembles (with its own rigid-body
     /// near-null space). GAMG then sets up on a quarter of the unknowns and on a far sparser
     /// matrix, which is where GAMG on P2 spends its memory.
