@@ -68,24 +68,21 @@ impl Mat {
             }
             let mat = Mat { raw };
             type Op = unsafe extern "C" fn();
+            type Binary = unsafe extern "C" fn(ffi::Mat, ffi::Vec, ffi::Vec) -> ffi::PetscErrorCode;
+            type Ternary =
+                unsafe extern "C" fn(ffi::Mat, ffi::Vec, ffi::Vec, ffi::Vec) -> ffi::PetscErrorCode;
             for (op, f) in [
-                (
-                    ffi::MatOperation_MATOP_MULT,
-                    mult_cb as unsafe extern "C" fn(ffi::Mat, ffi::Vec, ffi::Vec) -> _,
-                ),
+                (ffi::MatOperation_MATOP_MULT, mult_cb as Binary),
                 (ffi::MatOperation_MATOP_MULT_TRANSPOSE, mult_transpose_cb),
             ] {
                 // SAFETY: PETSc calls the operation back with the signature it was given.
-                let f = std::mem::transmute::<_, Op>(f);
+                let f = std::mem::transmute::<Binary, Op>(f);
                 check(
                     ffi::MatShellSetOperation(raw, op, Some(f)),
                     "MatShellSetOperation",
                 )?;
             }
-            let f = std::mem::transmute::<
-                unsafe extern "C" fn(ffi::Mat, ffi::Vec, ffi::Vec, ffi::Vec) -> _,
-                Op,
-            >(mult_add_cb);
+            let f = std::mem::transmute::<Ternary, Op>(mult_add_cb as Ternary);
             check(
                 ffi::MatShellSetOperation(raw, ffi::MatOperation_MATOP_MULT_ADD, Some(f)),
                 "MatShellSetOperation",
