@@ -120,18 +120,35 @@ fn the_p2_iterative_path_is_a_p_multigrid_unless_asked_for_gamg() {
         args.extend(extra);
         ok(&dir, 2, &args)
     };
-    // The outer PC is PCMG with two levels, a Chebyshev–Jacobi smoother on P2 and GAMG on the
-    // coarse P1 operator; asked for GAMG, there is no PCMG level at all.
+    // The outer PC is PCMG with two levels, a Jacobi smoother on P2 and GAMG on the coarse P1
+    // operator; asked for GAMG, there is no PCMG level at all.
     let pmg = view(&[]);
-    for want in [
-        "type: mg",
-        "levels=2",
-        "type: chebyshev",
-        "type: jacobi",
-        "type: gamg",
-    ] {
+    for want in ["type: mg", "levels=2", "type: gamg"] {
         assert!(pmg.contains(want), "no '{want}' in\n{pmg}");
     }
+    // On a symmetric tangent the P2 smoother is Richardson–Jacobi, damped by the Jacobian's
+    // spectral bound: 2 / (1.1 b) with the elements' Gershgorin bound b, about 0.45 (PETSc's
+    // own default would be 1).
+    let fine_smoother = |view: &str| {
+        let at = view
+            .find("KSP Object: (mg_levels_1_)")
+            .unwrap_or_else(|| panic!("no fine smoother in\n{view}"));
+        let end = view[at..]
+            .find("PC Object: (mg_levels_1_)")
+            .expect("its PC");
+        view[at..at + end].to_string()
+    };
+    let smoother = fine_smoother(&pmg);
+    assert!(smoother.contains("type: richardson"), "{smoother}");
+    let damping: f64 = smoother
+        .split("damping factor=")
+        .nth(1)
+        .and_then(|v| v.split_whitespace().next())
+        .and_then(|v| v.trim_end_matches('.').parse().ok())
+        .unwrap_or_else(|| panic!("no damping in\n{smoother}"));
+    assert!((0.3..0.6).contains(&damping), "damping {damping}");
+    let after_smoother = &pmg[pmg.find("KSP Object: (mg_levels_1_)").expect("found")..];
+    assert!(after_smoother.contains("type: jacobi"), "{after_smoother}");
     // The cantilever's tangent is symmetric: only its upper triangle is stored, in blocks.
     // Declared unsymmetric, the whole tangent is stored and GMRES replaces CG, with the same
     // history.
@@ -158,6 +175,12 @@ fn the_p2_iterative_path_is_a_p_multigrid_unless_asked_for_gamg() {
     for want in ["type: mpibaij", "type: sor"] {
         assert!(sor.contains(want), "no '{want}' in\n{sor}");
     }
+    // Named on the command line, the fine smoother is PETSc's Chebyshev again.
+    let chebyshev = view(&["-mg_levels_ksp_type", "chebyshev"]);
+    assert!(
+        fine_smoother(&chebyshev).contains("type: chebyshev"),
+        "{chebyshev}"
+    );
     // Asked for GAMG, or for any preconditioner on the command line (the p-multigrid's BAIJ
     // tangent would stop GAMG: "No method creategraph for Mat of type seqbaij").
     for asked in [&["-pfem_pmg", "false"][..], &["-pc_type", "gamg"][..]] {

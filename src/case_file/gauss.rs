@@ -19,7 +19,9 @@ use super::lockstep::Lockstep;
 /// Values per triangle: 3 Gauss points x 9 state values.
 pub const GAUSS_LEN: usize = 27;
 /// Node values per triangle: 6 nodes (vertices in key order, then the midside nodes of edges
-/// 01, 12, 20) x (displacement increment per whole step x, y; pressure, NaN if none).
+/// 01, 12, 20) x (displacement increment per whole step x, y; pressure, NaN if none). A node
+/// the run did not keep is NaN throughout: a P2 vertex (its particle's increment is the same)
+/// and, before a first solve, every node; a midside node's pressure is 0.
 pub const NODE_LEN: usize = 18;
 /// Contact values per triangle: 6 nodes (as in `nodes`) x (rigid body index, contact pressure,
 /// shear stress), NaN where the node touched no body.

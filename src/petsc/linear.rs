@@ -224,7 +224,8 @@ impl LinearSolver<'_> {
     /// spectral bound ([`crate::solve::smoother`]): on the p-multigrid with a symmetric
     /// tangent, unless the command line names the smoother, its preconditioner or its damping
     /// (`-mg_levels_ksp_type`, `-mg_levels_pc_type` other than jacobi,
-    /// `-mg_levels_ksp_richardson_scale`, or the same with `mg_levels_1_`). Against Chebyshev
+    /// `-mg_levels_ksp_richardson_scale`, `-mg_levels_pc_jacobi_type`, or the same with
+    /// `mg_levels_1_`; `-pc_mg_distinct_smoothup`, `-pc_mg_levels`). Against Chebyshev
     /// with its eigenvalue estimate, this drops six vectors of the fine level and the
     /// estimate's ten matrix products per Newton iteration.
     pub fn damps_jacobi_smoother(&self) -> Result<bool, PetscError> {
@@ -234,8 +235,21 @@ impl LinearSolver<'_> {
         if !*symmetric {
             return Ok(false);
         }
+        // A distinct up-smoother, more levels or another Jacobi diagonal would not be the
+        // smoother the bound describes.
+        for name in ["-pc_mg_distinct_smoothup", "-pc_mg_levels"] {
+            if option_string(name)?.is_some() {
+                return Ok(false);
+            }
+        }
         for prefix in ["-mg_levels_", "-mg_levels_1_"] {
-            for name in ["ksp_type", "ksp_richardson_scale"] {
+            for name in [
+                "ksp_type",
+                "ksp_richardson_scale",
+                "ksp_richardson_self_scale",
+                "pc_jacobi_type",
+                "pc_jacobi_abs",
+            ] {
                 if option_string(&format!("{prefix}{name}"))?.is_some() {
                     return Ok(false);
                 }

@@ -29,8 +29,8 @@ impl Mat {
         Mat::aij_rect(comm, [n_local, n_local], block, d_nnz, o_nnz)
     }
 
-    /// Collective. As [`Mat::aij`], with `local[0]` owned rows and `local[1]` owned columns (an
-    /// interpolation between two spaces); rows and columns share the block size.
+    /// Collective. As [`Mat::aij`], with `local[0]` owned rows and `local[1]` owned columns;
+    /// rows and columns share the block size.
     pub fn aij_rect(
         comm: &SimpleCommunicator,
         local: [usize; 2],

@@ -35,6 +35,10 @@ impl Mat {
         local: [usize; 2],
         op: Box<dyn LinearOperator>,
     ) -> Result<Mat, PetscError> {
+        let (rows, cols) = (
+            to_int(local[0], "shell rows")?,
+            to_int(local[1], "shell columns")?,
+        );
         let ctx = Box::into_raw(Box::new(op)) as *mut c_void;
         let mut raw: ffi::Mat = std::ptr::null_mut();
         let decide = ffi::PETSC_DETERMINE as ffi::PetscInt;
@@ -42,15 +46,7 @@ impl Mat {
         // the callback is registered, a failure reclaims it here.
         unsafe {
             let created = check(
-                ffi::MatCreateShell(
-                    comm.as_raw(),
-                    to_int(local[0], "shell rows")?,
-                    to_int(local[1], "shell columns")?,
-                    decide,
-                    decide,
-                    ctx,
-                    &mut raw,
-                ),
+                ffi::MatCreateShell(comm.as_raw(), rows, cols, decide, decide, ctx, &mut raw),
                 "MatCreateShell",
             )
             .and_then(|()| {

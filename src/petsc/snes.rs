@@ -265,6 +265,12 @@ impl Snes {
 }
 
 impl Snes {
+    /// Whether the p-multigrid's fine smoother takes its damping from each Jacobian
+    /// ([`NonlinearProblem::smoother_damping`]): the problem must then give one.
+    pub fn damps_smoother(&self) -> bool {
+        self.damped_smoother
+    }
+
     /// Collective. Frees what the last solve set up (work vectors, the preconditioner's
     /// hierarchy and the Krylov method's vectors), keeping the configuration; the next solve
     /// sets up again.
@@ -355,8 +361,9 @@ unsafe extern "C" fn jacobian_cb(
             Some(damping) => damp_smoother(snes, damping),
             None => Err(PetscError {
                 code: PETSC_ERR_USER,
-                message: "the p-multigrid's Jacobi smoother needs a spectral bound that this \
-                          Jacobian did not give"
+                message: "the p-multigrid's Jacobi smoother has no damping: this Jacobian gave \
+                          no finite bound on its spectrum (an element tangent with a negative \
+                          or zero diagonal, or not a number)"
                     .into(),
             }),
         };

@@ -506,6 +506,9 @@ impl Simulation {
                 matrix: &m.coarse,
                 space: &m.space,
             });
+            if snes.damps_smoother() {
+                problem = problem.with_jacobi_bound();
+            }
         }
         if let Some(split) = split {
             problem = problem.with_schur_preconditioner(SchurPreconditioner {

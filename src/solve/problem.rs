@@ -97,8 +97,10 @@ pub struct StepProblem<'a> {
     schur: Option<SchurPreconditioner<'a>>,
     /// Where the Jacobian also assembles the p-multigrid's coarse operator.
     coarse: Option<CoarseOperator<'a>>,
-    /// With the coarse operator, the last Jacobian's bound on the spectrum of diag(J)⁻¹J
-    /// ([`super::smoother`]), the same on every rank.
+    /// Whether every Jacobian bounds the spectrum of diag(J)⁻¹J ([`super::smoother`]) for
+    /// the p-multigrid's smoother; the same on every rank (the bound is an allreduce).
+    bound_jacobi_spectrum: bool,
+    /// The last Jacobian's bound, the same on every rank.
     jacobi_bound: Cell<Option<f64>>,
     /// The element results of the last residual and the local vector they belong to. SNES asks
     /// for the Jacobian at the iterate whose residual it has just evaluated, and the converged
@@ -154,6 +156,7 @@ impl<'a> StepProblem<'a> {
             diagonal: Cell::new(None),
             schur: None,
             coarse: None,
+            bound_jacobi_spectrum: false,
             jacobi_bound: Cell::new(None),
             cache: RefCell::new(None),
             keep_elements: true,
@@ -221,6 +224,15 @@ impl<'a> StepProblem<'a> {
 
     /// Evaluates the elements afresh for every residual and Jacobian instead of keeping the
     /// last residual's (see `cache`).
+    /// Every Jacobian bounds the spectrum of diag(J)⁻¹J for the p-multigrid's smoother
+    /// ([`NonlinearProblem::smoother_damping`]). Every rank must agree, and the tangent must be
+    /// the sum of symmetric element tangents alone: contact and follower pressures add terms
+    /// that are neither.
+    pub fn with_jacobi_bound(mut self) -> Self {
+        self.bound_jacobi_spectrum = true;
+        self
+    }
+
     pub fn without_element_cache(mut self) -> Self {
         self.keep_elements = false;
         self
@@ -751,7 +763,10 @@ impl NonlinearProblem for StepProblem<'_> {
     }
 
     fn smoother_damping(&self) -> Option<f64> {
-        self.jacobi_bound.get().map(jacobi_damping)
+        self.jacobi_bound
+            .get()
+            .filter(|b| b.is_finite())
+            .map(jacobi_damping)
     }
 
     fn jacobian(&mut self, x: VecRef<'_>, j: MatRef<'_>) -> Result<(), CallbackError> {
@@ -768,7 +783,11 @@ impl NonlinearProblem for StepProblem<'_> {
         let mut vals = Vec::new();
         let (mut sorted_cols, mut sorted_dofs) = ([0 as Int; 15], [0u8; 15]);
         let mut jacobi_bound: f64 = 0.0;
-        let bounded = self.bounds_jacobi_spectrum();
+        let bounded = self.bound_jacobi_spectrum;
+        debug_assert!(
+            !bounded || (self.setup.contact.is_empty() && self.setup.surface.is_empty()),
+            "contact and follower pressures are neither element matrices nor symmetric"
+        );
         let evaluated = self.evaluate(x, true, |t, e| {
             if let Some(c) = &self.coarse {
                 let m = c.matrix.as_ref();
@@ -896,13 +915,6 @@ impl NonlinearProblem for StepProblem<'_> {
 }
 
 impl StepProblem<'_> {
-    /// Whether the Jacobian bounds the spectrum of diag(J)⁻¹J (for the p-multigrid's smoother):
-    /// where the tangent is the sum of the element tangents alone. Contact and follower
-    /// pressures add terms that are neither element matrices nor symmetric.
-    fn bounds_jacobi_spectrum(&self) -> bool {
-        self.coarse.is_some() && self.setup.contact.is_empty() && self.setup.surface.is_empty()
-    }
-
     /// Collective. Gives the prescribed coarse rows the mean free coarse diagonal (from this
     /// rank's sum of its free diagonal entries) and assembles the coarse operator. Contact and
     /// follower pressures stay on the fine level: their terms couple a node, or a boundary

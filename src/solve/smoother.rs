@@ -18,20 +18,24 @@ pub fn jacobi_damping(bound: f64) -> f64 {
 /// An upper bound on the eigenvalues of diag(K)⁻¹K for the row-major `n` × `n` symmetric element
 /// matrix `k` restricted to its free dofs (bit i of `fixed` set: dof i prescribed, its row and
 /// column zero in the assembled matrix). Gershgorin on D^(−1/2) K D^(−1/2): the largest row sum
-/// of |kᵢⱼ| / √(kᵢᵢ kⱼⱼ). A free row with a zero diagonal and a nonzero off-diagonal gives
-/// infinity: no damping is safe there.
+/// of |kᵢⱼ| / √(kᵢᵢ kⱼⱼ). A free row with a negative diagonal, or a zero one and a nonzero
+/// off-diagonal, and any NaN give infinity: no damping is safe there.
 pub fn element_jacobi_bound(k: &[f64], n: usize, fixed: u16) -> f64 {
     debug_assert!(n <= 16 && k.len() >= n * n);
     // 1/√kᵢᵢ on free dofs, 0 on prescribed ones (their rows and columns take no part).
     let mut scale = [0.0; 16];
     for (i, s) in scale.iter_mut().enumerate().take(n) {
-        let d = k[i * n + i].abs();
+        let d = k[i * n + i];
         if fixed & 1 << i != 0 {
             continue;
         }
         if d > 0.0 {
             *s = 1.0 / d.sqrt();
-        } else if (0..n).any(|j| j != i && fixed & 1 << j == 0 && k[i * n + j] != 0.0) {
+        } else if d < 0.0
+            || d.is_nan()
+            || (0..n).any(|j| j != i && fixed & 1 << j == 0 && k[i * n + j] != 0.0)
+        {
+            // The summation argument needs non-negative diagonals.
             return f64::INFINITY;
         }
     }
@@ -48,6 +52,9 @@ pub fn element_jacobi_bound(k: &[f64], n: usize, fixed: u16) -> f64 {
             rows[i] += v;
             rows[j] += v;
         }
+    }
+    if rows[..n].iter().any(|r| r.is_nan()) {
+        return f64::INFINITY;
     }
     rows[..n].iter().fold(0.0, |m: f64, &r| m.max(r))
 }
@@ -129,6 +136,14 @@ mod tests {
         let k = [0.0, 1.0, 1.0, 2.0];
         assert_eq!(element_jacobi_bound(&k, 2, 0), f64::INFINITY);
         assert!((element_jacobi_bound(&k, 2, 0b01) - 1.0).abs() < 1e-15);
+        assert_eq!(
+            element_jacobi_bound(&[-1.0, 0.0, 0.0, 2.0], 2, 0),
+            f64::INFINITY
+        );
+        assert_eq!(
+            element_jacobi_bound(&[1.0, f64::NAN, f64::NAN, 2.0], 2, 0),
+            f64::INFINITY
+        );
         assert!((jacobi_damping(4.0) - 2.0 / 4.4).abs() < 1e-15);
     }
 }
