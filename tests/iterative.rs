@@ -622,3 +622,70 @@ fn auto_turns_to_the_p_multigrid_where_it_is_faster() {
         assert_eq!(view.contains("type: cholesky"), !iterative, "h = {h}");
     }
 }
+
+/// The p-multigrid on a scene with contact (its tangent is not symmetric: GMRES, and PETSc's
+/// Chebyshev on P2) on 2 ranks, where the contact pairs lie on one rank's part: every
+/// collective call of the Jacobian must be made on both. (A first version decided whether to
+/// bound the spectrum from each rank's own contact list, so one rank's allreduce met another
+/// collective and the run hung; a hang ends here at the timeout, as a failure.)
+#[test]
+fn the_p_multigrid_runs_a_contact_scene_on_2_ranks() {
+    let dir = workdir("iterative-pmg-contact");
+    ok(
+        &dir,
+        1,
+        &[
+            "new",
+            "footing",
+            "-o",
+            "f.h5",
+            "--set",
+            "material.model=\"linear-elastic\"",
+            "--set",
+            "solver.element=\"p2\"",
+            "--set",
+            "solver.linear=\"iterative\"",
+            "--set",
+            "mesh.fine=[]",
+        ],
+    );
+    let out = std::process::Command::new("timeout")
+        .args([
+            "120",
+            "mpirun",
+            "-n",
+            "2",
+            "--oversubscribe",
+            "--bind-to",
+            "none",
+        ])
+        .args([
+            common::bin(),
+            "f.h5",
+            "--until-step",
+            "1",
+            "--",
+            "-ksp_view",
+        ])
+        .env("OMP_NUM_THREADS", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .current_dir(&dir)
+        .output()
+        .expect("launch mpirun");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "status {:?}\n{stdout}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let fine = &stdout[stdout
+        .find("KSP Object: (mg_levels_1_)")
+        .expect("a PCMG level")..];
+    assert!(
+        fine.starts_with("KSP Object: (mg_levels_1_) 2 MPI processes\n      type: chebyshev"),
+        "{fine}"
+    );
+    assert!(stdout.contains("done: step 1"), "{stdout}");
+}
