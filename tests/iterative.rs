@@ -683,9 +683,7 @@ fn the_p_multigrid_runs_a_contact_scene_on_2_ranks() {
     let fine = &stdout[stdout
         .find("KSP Object: (mg_levels_1_)")
         .expect("a PCMG level")..];
-    assert!(
-        fine.starts_with("KSP Object: (mg_levels_1_) 2 MPI processes\n      type: chebyshev"),
-        "{fine}"
-    );
+    let fine = &fine[..fine.find("PC Object").expect("its PC")];
+    assert!(fine.contains("type: chebyshev"), "{fine}");
     assert!(stdout.contains("done: step 1"), "{stdout}");
 }
