@@ -176,19 +176,12 @@ mod tests {
         // A rank owning vertices 0 and 1 and the midside nodes of edges (0, 1) and (0, 2);
         // vertex 2 and edge (1, 2) are another rank's. Coarse numbers run against the local
         // order; x is prescribed at points 1 and 2.
-        let dofs = DofMap {
-            node_of_point: vec![0, 1, 2],
-            edges: vec![[0, 1], [1, 2], [0, 2]],
-            tri_nodes: vec![[0, 1, 2, 3, 4, 5]],
-            node_global: vec![100, 102, 0, 104, 2, 106],
-            node_local: vec![0, 2, 4, 6, 8, 10],
-            vertex_dofs: 2,
-            node_owned: vec![true, true, false, true, false, true],
-            node_point: vec![0, 1, 2, u32::MAX, u32::MAX, u32::MAX],
-            n_owned_dofs: 8,
-            first_dof: 100,
-            n_global_dofs: 112,
-        };
+        let dofs = super::super::pmg::one_triangle_dofs(
+            [100, 102, 0, 104, 2, 106],
+            [true, true, false, true, false, true],
+            100,
+            112,
+        );
         let space = CoarseSpace::for_tests(4, 50, vec![52, 50, 10]);
         let constraints =
             Constraints::build(&dofs, |p| [if p == 0 { None } else { Some(0.0) }, None]);

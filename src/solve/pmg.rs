@@ -214,6 +214,30 @@ pub fn galerkin_product(
     coarse
 }
 
+/// The P2 dofs of one triangle on points 0, 1, 2 (nodes: the vertices, then edges 01, 12, 02),
+/// with the given global numbers and owners; for tests.
+#[cfg(test)]
+pub(super) fn one_triangle_dofs(
+    node_global: [usize; 6],
+    node_owned: [bool; 6],
+    first_dof: usize,
+    n_global_dofs: usize,
+) -> DofMap {
+    DofMap {
+        node_of_point: vec![0, 1, 2],
+        edges: vec![[0, 1], [1, 2], [0, 2]],
+        tri_nodes: vec![[0, 1, 2, 3, 4, 5]],
+        node_global: node_global.to_vec(),
+        node_local: vec![0, 2, 4, 6, 8, 10],
+        vertex_dofs: 2,
+        node_owned: node_owned.to_vec(),
+        node_point: vec![0, 1, 2, u32::MAX, u32::MAX, u32::MAX],
+        n_owned_dofs: 2 * node_owned.iter().filter(|&&o| o).count(),
+        first_dof,
+        n_global_dofs,
+    }
+}
+
 fn n_vertex_nodes(dofs: &DofMap) -> usize {
     dofs.n_nodes() - dofs.edges.len()
 }
@@ -297,19 +321,7 @@ mod tests {
     #[test]
     fn galerkin_blocks_reach_petsc_under_their_own_columns_in_increasing_order() {
         // One triangle whose vertices' coarse numbers run against their local order.
-        let dofs = DofMap {
-            node_of_point: vec![0, 1, 2],
-            edges: vec![[0, 1], [1, 2], [0, 2]],
-            tri_nodes: vec![[0, 1, 2, 3, 4, 5]],
-            node_global: vec![0, 2, 4, 6, 8, 10],
-            node_local: vec![0, 2, 4, 6, 8, 10],
-            vertex_dofs: 2,
-            node_owned: vec![true; 6],
-            node_point: vec![0, 1, 2, u32::MAX, u32::MAX, u32::MAX],
-            n_owned_dofs: 12,
-            first_dof: 0,
-            n_global_dofs: 12,
-        };
+        let dofs = one_triangle_dofs([0, 2, 4, 6, 8, 10], [true; 6], 0, 12);
         let space = CoarseSpace {
             n_owned: 6,
             first: 0,
