@@ -38,10 +38,10 @@ pub enum LinearSolver<'a> {
     /// the P2 system: one Jacobi sweep before and after on P2 (Richardson damped by the
     /// Jacobian's spectral bound where the tangent is symmetric,
     /// [`LinearSolver::damps_jacobi_smoother`]; Chebyshev elsewhere), `interpolation` (a shell
-    /// operator) from P1 on the particles, and two GAMG cycles (Richardson) on `coarse`, the Galerkin product
-    /// of the element tangents that every Jacobian assembles (with its own rigid-body
-    /// near-null space). GAMG then sets up on a quarter of the unknowns and on a far sparser
-    /// matrix, which is where GAMG on P2 spends its memory.
+    /// operator) from P1 on the particles, and two GAMG cycles (Richardson) on `coarse`, the
+    /// Galerkin product of the element tangents that every Jacobian assembles (with its own
+    /// rigid-body near-null space). GAMG then sets up on a quarter of the unknowns and on a far
+    /// sparser matrix, which is where GAMG on P2 spends its memory.
     PMultigrid {
         rtol: Scalar,
         symmetric: bool,

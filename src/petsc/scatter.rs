@@ -78,17 +78,15 @@ impl Scatter {
         }
         self.local.as_ref().read(f)
     }
-}
 
-impl Scatter {
     /// Collective. The reverse of [`Self::gather`]: `f` fills one value per local entry, which
     /// is added to its global entry of `into` (several ranks may add to one entry).
     pub fn add_back(
         &self,
         into: VecRef<'_>,
-        f: impl FnOnce(&mut [super::Scalar]),
+        f: impl FnOnce(&mut [super::Scalar]) -> Result<(), PetscError>,
     ) -> Result<(), PetscError> {
-        self.local.as_ref().write(f)?;
+        self.local.as_ref().write(f)??;
         // SAFETY: both vectors are live and match the layouts the scatter was built for.
         unsafe {
             check(

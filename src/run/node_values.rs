@@ -15,7 +15,7 @@ pub struct NodeValues {
 impl NodeValues {
     /// From entries in any order; of repeated keys the first is kept. Vertices are kept only
     /// with `pressures`.
-    pub fn new(entries: Vec<([u64; 2], [f64; 3])>, pressures: bool) -> Self {
+    pub fn new(entries: impl IntoIterator<Item = ([u64; 2], [f64; 3])>, pressures: bool) -> Self {
         let mut vertices = Vec::new();
         let mut edges = Vec::new();
         for (key, v) in entries {

@@ -39,10 +39,11 @@ impl SolverObjects {
     }
 }
 
-/// The coarse level of the two-level p-multigrid (iterative P2 path, `-pfem_pmg`): the
-/// interpolation (an operator, [`Interpolation`]) and the near-null space are made at every
-/// increment's start (its geometry and constraints), the coarse operator at every Jacobian
-/// (the tangent's Galerkin product).
+/// The coarse level of the two-level p-multigrid (iterative P2 path, `-pfem_pmg`), made with
+/// the solver objects at every increment's start: the interpolation (an operator,
+/// [`Interpolation`]) and the coarse near-null space from that increment's geometry and
+/// constraints; the coarse operator is assembled at every Jacobian (the tangent's Galerkin
+/// product).
 struct PMultigrid {
     space: CoarseSpace,
     interpolation: Mat,
@@ -351,6 +352,10 @@ impl Simulation {
                 let (d_nnz, o_nnz) = CoarseSpace::operator_preallocation(dofs);
                 Mat::aij(world, space.n_owned, 2, &d_nnz, &o_nnz)?
             };
+            // The coarse nodes' rigid-body modes at the increment's start, for GAMG (the
+            // matrix holds its own reference to the space).
+            let modes = orthonormal_rigid_body_modes(world, &space.coordinates(mesh, dofs));
+            coarse.set_near_null_space(&NullSpace::new(world, space.n_owned, &modes)?)?;
             Some(PMultigrid {
                 space,
                 interpolation,
@@ -493,9 +498,6 @@ impl Simulation {
             pmg,
             ..
         } = objects;
-        if let Some(m) = pmg {
-            fill_p_multigrid(world, mesh, dofs, m).map_err(err)?;
-        }
         let mut problem =
             StepProblem::new(world, mesh, dofs, setup, x).map_err(|e| err(e.to_string()))?;
         if iterative {
@@ -721,7 +723,7 @@ impl Simulation {
             (node_key(mesh, &solved.dofs, n), v)
         });
         *self.last_nodes.borrow_mut() =
-            super::node_values::NodeValues::new(last.collect(), self.model.mixed());
+            super::node_values::NodeValues::new(last, self.model.mixed());
         self.particles.state = recover_at_particles(mesh, &solved.states, &self.particles.state);
         self.tri_states = TriStates::new(mesh, solved.states);
         self.last_reaction = solved.reaction;
@@ -856,22 +858,6 @@ fn owned_area(mesh: &LocalMesh, du: &[[f64; 2]], dofs: &DofMap) -> f64 {
         area += 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
     }
     area
-}
-
-/// Collective. The p-multigrid coarse level's rigid-body near-null space for this increment
-/// (start-of-step geometry); the interpolation is made with the solver objects, and the coarse
-/// operator is assembled with every Jacobian ([`CoarseOperator`]).
-fn fill_p_multigrid(
-    world: &Comm,
-    mesh: &LocalMesh,
-    dofs: &DofMap,
-    m: &PMultigrid,
-) -> Result<(), String> {
-    let petsc = |e: PetscError| e.to_string();
-    let modes = orthonormal_rigid_body_modes(world, &m.space.coordinates(mesh, dofs));
-    // The matrix holds its own reference to the space.
-    let space = NullSpace::new(world, m.space.n_owned, &modes).map_err(petsc)?;
-    m.coarse.set_near_null_space(&space).map_err(petsc)
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@
 //! order PETSc's AIJ product ran it (owned columns, then ghosts, each by global number), so
 //! the results are bit for bit those of the stored matrix.
 
-use super::pmg::{interpolation_ends, CoarseSpace};
+use super::pmg::{n_vertex_nodes, CoarseSpace};
 use super::{Constraints, DofMap};
 use crate::petsc::{LinearOperator, PVec, PetscError, Scalar, Scatter, VecRef};
 use pfem_partition::Comm;
@@ -36,10 +36,10 @@ impl InterpolationMap {
         let owned: Vec<usize> = (0..dofs.n_nodes())
             .filter(|&n| dofs.node_owned[n])
             .collect();
+        let n_vertex = n_vertex_nodes(dofs);
         let mut ghosts: Vec<usize> = owned
             .iter()
-            .flat_map(|&n| interpolation_ends(dofs, n))
-            .map(|(v, _)| v)
+            .flat_map(|&n| vertices_of(dofs, n_vertex, n))
             .filter(|&v| !dofs.node_owned[v])
             .map(|v| space.coarse_dof(v))
             .collect();
@@ -59,12 +59,14 @@ impl InterpolationMap {
         let mut live = vec![0u8; ends.len()];
         for &n in &owned {
             let i = (dofs.node_global[n] - dofs.first_dof) / 2;
-            let mut by_slot: Vec<(u32, usize)> = interpolation_ends(dofs, n)
-                .into_iter()
-                .map(|(v, _)| (slot(v), v))
-                .collect();
-            by_slot.sort_unstable();
-            for (e, &(s, v)) in by_slot.iter().enumerate() {
+            let mut by_slot = [(NONE, 0); 2];
+            let mut len = 0;
+            for v in vertices_of(dofs, n_vertex, n) {
+                by_slot[len] = (slot(v), v);
+                len += 1;
+            }
+            by_slot[..len].sort_unstable();
+            for (e, &(s, v)) in by_slot[..len].iter().enumerate() {
                 ends[i][e] = s;
                 for c in 0..2 {
                     if !constraints.is_fixed(n, c) && !constraints.is_fixed(v, c) {
@@ -129,6 +131,17 @@ impl InterpolationMap {
     }
 }
 
+/// The vertex nodes node `n` interpolates from (weight 1 for its own vertex, 1/2 for each
+/// end of its edge): a vertex node is the first `n_vertex` nodes' own.
+fn vertices_of(dofs: &DofMap, n_vertex: usize, n: usize) -> impl Iterator<Item = usize> + '_ {
+    let ends = if n < n_vertex {
+        [Some(n), None]
+    } else {
+        dofs.edges[n - n_vertex].map(|p| Some(dofs.node_of_point[p as usize] as usize))
+    };
+    ends.into_iter().flatten()
+}
+
 /// The interpolation as a PETSc operator: the map and the scatter of its coarse ghosts.
 pub struct Interpolation {
     map: InterpolationMap,
@@ -161,9 +174,9 @@ impl LinearOperator for Interpolation {
     }
 
     fn mult_transpose(&self, y: VecRef<'_>, x: VecRef<'_>) -> Result<(), PetscError> {
-        let mut ghost = vec![0.0; self.map.ghost_dofs.len()];
-        y.read(|fine| x.write(|own| self.map.restrict(fine, own, &mut ghost)))??;
-        self.ghosts.add_back(x, |g| g.copy_from_slice(&ghost))
+        self.ghosts.add_back(x, |ghost| {
+            y.read(|fine| x.write(|own| self.map.restrict(fine, own, ghost)))?
+        })
     }
 }
 

@@ -238,21 +238,9 @@ pub(super) fn one_triangle_dofs(
     }
 }
 
-fn n_vertex_nodes(dofs: &DofMap) -> usize {
+/// The vertex nodes come first in a dof map's node order.
+pub(super) fn n_vertex_nodes(dofs: &DofMap) -> usize {
     dofs.n_nodes() - dofs.edges.len()
-}
-
-/// The vertex nodes node `n` interpolates from, with their weights.
-pub(super) fn interpolation_ends(dofs: &DofMap, n: usize) -> Vec<(usize, f64)> {
-    let n_vertex = n_vertex_nodes(dofs);
-    if n < n_vertex {
-        return vec![(n, 1.0)];
-    }
-    let [a, b] = dofs.edges[n - n_vertex];
-    vec![
-        (dofs.node_of_point[a as usize] as usize, 0.5),
-        (dofs.node_of_point[b as usize] as usize, 0.5),
-    ]
 }
 
 #[cfg(test)]

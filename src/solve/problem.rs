@@ -222,8 +222,6 @@ impl<'a> StepProblem<'a> {
         self
     }
 
-    /// Evaluates the elements afresh for every residual and Jacobian instead of keeping the
-    /// last residual's (see `cache`).
     /// Every Jacobian bounds the spectrum of diag(J)⁻¹J for the p-multigrid's smoother
     /// ([`NonlinearProblem::smoother_damping`]). Every rank must agree, and the tangent must be
     /// the sum of symmetric element tangents alone: contact and follower pressures add terms
@@ -233,6 +231,8 @@ impl<'a> StepProblem<'a> {
         self
     }
 
+    /// Evaluates the elements afresh for every residual and Jacobian instead of keeping the
+    /// last residual's (see `cache`).
     pub fn without_element_cache(mut self) -> Self {
         self.keep_elements = false;
         self
