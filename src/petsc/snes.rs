@@ -49,6 +49,9 @@ pub struct Snes {
     /// The p-multigrid's fine smoother takes its damping from each Jacobian's spectral bound
     /// ([`LinearSolver::damps_jacobi_smoother`]).
     damped_smoother: bool,
+    /// The p-multigrid's coarse solver is set up from the first Jacobian of a solve
+    /// ([`set_up_coarse_solver`]).
+    coarse_first: bool,
 }
 
 struct Ctx<'a> {
@@ -58,6 +61,8 @@ struct Ctx<'a> {
     /// The residual norm at the last Jacobian of this solve.
     last_norm: Option<f64>,
     damped_smoother: bool,
+    /// Set up the p-multigrid's coarse solver at the next Jacobian (the first of the solve).
+    coarse_first: bool,
 }
 
 const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
@@ -93,6 +98,7 @@ impl Snes {
                 raw,
                 reuse,
                 damped_smoother: linear.damps_jacobi_smoother()?,
+                coarse_first: matches!(linear, LinearSolver::PMultigrid { .. }),
             };
             check(
                 ffi::SNESSetTolerances(
@@ -165,6 +171,7 @@ impl Snes {
             reuse: self.reuse,
             last_norm: None,
             damped_smoother: self.damped_smoother,
+            coarse_first: self.coarse_first,
         };
         let ctx_ptr = &mut ctx as *mut Ctx as *mut c_void;
         // SAFETY: ctx outlives SNESSolve, the only place the callbacks run; the callbacks catch
@@ -372,6 +379,13 @@ unsafe extern "C" fn jacobian_cb(
             return PETSC_ERR_USER;
         }
     }
+    if ctx.coarse_first {
+        ctx.coarse_first = false;
+        if let Err(e) = set_up_coarse_solver(snes) {
+            ctx_note(ctx, Some(()), &e.to_string());
+            return PETSC_ERR_USER;
+        }
+    }
     match ctx.reuse {
         Some(reuse) => match choose_factorisation(snes, &reuse, &mut ctx.last_norm) {
             Ok(()) => 0,
@@ -402,6 +416,29 @@ fn damp_smoother(snes: ffi::SNES, damping: f64) -> Result<(), PetscError> {
             ffi::KSPRichardsonSetScale(smoother, damping),
             "KSPRichardsonSetScale",
         )
+    }
+}
+
+/// Collective. Sets up the p-multigrid's coarse solver (GAMG on the coarse operator the
+/// Jacobian has just assembled) before the Krylov method, the multigrid and its fine smoother
+/// allocate their vectors of the fine level: GAMG's first aggregation of a solve is the memory
+/// peak of the iterative path, and those six vectors need not sit under it. The outer set-up
+/// that follows finds the coarse solver set up for this operator and leaves it.
+fn set_up_coarse_solver(snes: ffi::SNES) -> Result<(), PetscError> {
+    let mut ksp: ffi::KSP = std::ptr::null_mut();
+    let mut pc: ffi::PC = std::ptr::null_mut();
+    let mut coarse: ffi::KSP = std::ptr::null_mut();
+    // SAFETY: the SNES is live during its callback; KSP, PC and coarse KSP are borrowed from it.
+    unsafe {
+        check(ffi::SNESGetKSP(snes, &mut ksp), "SNESGetKSP")?;
+        check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
+        check(
+            ffi::PCMGGetCoarseSolve(pc, &mut coarse),
+            "PCMGGetCoarseSolve",
+        )?;
+        // Its options are read first, as the multigrid's own set-up would read them.
+        check(ffi::KSPSetFromOptions(coarse), "KSPSetFromOptions(coarse)")?;
+        check(ffi::KSPSetUp(coarse), "KSPSetUp(coarse)")
     }
 }
 
