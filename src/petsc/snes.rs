@@ -381,7 +381,9 @@ unsafe extern "C" fn jacobian_cb(
     }
     if ctx.coarse_first {
         ctx.coarse_first = false;
-        if let Err(e) = set_up_coarse_solver(snes) {
+        // SAFETY: PETSc keeps x alive during the callback.
+        let x = unsafe { VecRef::lent(x) };
+        if let Err(e) = set_up_coarse_solver(snes).and_then(|()| share_work_vector(snes, x)) {
             ctx_note(ctx, Some(()), &e.to_string());
             return PETSC_ERR_USER;
         }
@@ -415,6 +417,85 @@ fn damp_smoother(snes: ffi::SNES, damping: f64) -> Result<(), PetscError> {
         check(
             ffi::KSPRichardsonSetScale(smoother, damping),
             "KSPRichardsonSetScale",
+        )
+    }
+}
+
+/// Collective. One vector of the fine level serves as the p-multigrid's residual and as
+/// the full-step line search's trial point, instead of three. The multigrid's residual is
+/// written and read only inside a preconditioner application, the trial point only inside
+/// the line search, which follows the linear solve; the full step never touches its
+/// second vector (the trial residual: it evaluates into the residual itself). Any other
+/// line search keeps its own pair. Measured: two vectors of the fine level fewer at the
+/// memory peak.
+fn share_work_vector(snes: ffi::SNES, x: VecRef<'_>) -> Result<(), PetscError> {
+    let mut ls: ffi::SNESLineSearch = std::ptr::null_mut();
+    let mut kind: *const std::os::raw::c_char = std::ptr::null();
+    // SAFETY: the SNES is live during its callback; its line search is borrowed; the type
+    // name is PETSc's.
+    let basic = unsafe {
+        check(ffi::SNESGetLineSearch(snes, &mut ls), "SNESGetLineSearch")?;
+        check(
+            ffi::SNESLineSearchGetType(ls, &mut kind),
+            "SNESLineSearchGetType",
+        )?;
+        !kind.is_null() && std::ffi::CStr::from_ptr(kind).to_bytes() == b"basic"
+    };
+    if !basic {
+        return Ok(());
+    }
+    // Once per set-up: a later solve on the same SNES (contact's augmentations) finds the line
+    // search's vectors in place.
+    let mut w: ffi::Vec = std::ptr::null_mut();
+    // SAFETY: as above; the vectors are only looked at.
+    unsafe {
+        check(
+            ffi::SNESLineSearchGetVecs(
+                ls,
+                std::ptr::null_mut(),
+                std::ptr::null_mut(),
+                std::ptr::null_mut(),
+                &mut w,
+                std::ptr::null_mut(),
+            ),
+            "SNESLineSearchGetVecs",
+        )?;
+    }
+    if !w.is_null() {
+        return Ok(());
+    }
+    let shared = x.duplicate()?;
+    let mut ksp: ffi::KSP = std::ptr::null_mut();
+    let mut pc: ffi::PC = std::ptr::null_mut();
+    // SAFETY: live SNES; KSP and PC are borrowed from it. The multigrid takes its own
+    // reference to the vector; the line search takes none but destroys both of its
+    // vectors on reset, so it is given one reference for each. Ours goes with `shared`.
+    unsafe {
+        check(ffi::SNESGetKSP(snes, &mut ksp), "SNESGetKSP")?;
+        check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
+        // Level 1 is the fine level only in the two-level hierarchy we build.
+        let mut levels: ffi::PetscInt = 0;
+        check(ffi::PCMGGetLevels(pc, &mut levels), "PCMGGetLevels")?;
+        if levels != 2 {
+            return Ok(());
+        }
+        check(ffi::PCMGSetR(pc, 1, shared.raw), "PCMGSetR")?;
+        for _ in 0..2 {
+            check(
+                ffi::PetscObjectReference(shared.raw as ffi::PetscObject),
+                "PetscObjectReference",
+            )?;
+        }
+        check(
+            ffi::SNESLineSearchSetVecs(
+                ls,
+                std::ptr::null_mut(),
+                std::ptr::null_mut(),
+                std::ptr::null_mut(),
+                shared.raw,
+                shared.raw,
+            ),
+            "SNESLineSearchSetVecs",
         )
     }
 }

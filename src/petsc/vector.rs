@@ -57,13 +57,7 @@ impl PVec {
 
     /// Collective. Same layout, uninitialised values.
     pub fn duplicate(&self) -> Result<PVec, PetscError> {
-        let mut raw: ffi::Vec = std::ptr::null_mut();
-        // SAFETY: self.raw is a live vector.
-        check(
-            unsafe { ffi::VecDuplicate(self.raw, &mut raw) },
-            "VecDuplicate",
-        )?;
-        Ok(PVec { raw })
+        self.as_ref().duplicate()
     }
 
     pub fn as_ref(&self) -> VecRef<'_> {
@@ -93,6 +87,17 @@ impl VecRef<'_> {
             raw,
             _owner: PhantomData,
         }
+    }
+
+    /// Collective. A new vector of the same layout, uninitialised values.
+    pub fn duplicate(&self) -> Result<PVec, PetscError> {
+        let mut raw: ffi::Vec = std::ptr::null_mut();
+        // SAFETY: self.raw is a live vector.
+        check(
+            unsafe { ffi::VecDuplicate(self.raw, &mut raw) },
+            "VecDuplicate",
+        )?;
+        Ok(PVec { raw })
     }
 
     /// The locally owned entries, read-only.
