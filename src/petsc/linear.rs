@@ -142,7 +142,7 @@ pub fn upper_triangle_smoother_from_options() -> Result<bool, PetscError> {
 }
 
 /// The PETSc option `name` as a boolean (`true`/`false`, `1`/`0`, ...), or `default`.
-fn bool_option(name: &str, default: bool) -> Result<bool, PetscError> {
+pub(super) fn bool_option(name: &str, default: bool) -> Result<bool, PetscError> {
     let n = cstring(name)?;
     let mut on = if default {
         ffi::PetscBool_PETSC_TRUE

@@ -1,7 +1,7 @@
 use super::error::{check, PetscError};
 use super::ffi;
 use super::init::cstring;
-use super::linear::{FactorReuse, LinearSolver};
+use super::linear::{bool_option, FactorReuse, LinearSolver};
 use super::matrix::{to_int, Mat, MatRef};
 use super::reason::{Divergence, KspDiverged, SnesDiverged, SolveFailure};
 use super::vector::{PVec, VecRef};
@@ -519,7 +519,27 @@ fn set_up_coarse_solver(snes: ffi::SNES) -> Result<(), PetscError> {
         )?;
         // Its options are read first, as the multigrid's own set-up would read them.
         check(ffi::KSPSetFromOptions(coarse), "KSPSetFromOptions(coarse)")?;
-        check(ffi::KSPSetUp(coarse), "KSPSetUp(coarse)")
+        check(ffi::KSPSetUp(coarse), "KSPSetUp(coarse)")?;
+        // GAMG has aggregated with the rigid-body modes. With its interpolation reused, the
+        // set-ups of the later Newton iterations only redo the Galerkin products and never read
+        // the modes again, so their vectors are freed (three of the coarse level).
+        let mut coarse_pc: ffi::PC = std::ptr::null_mut();
+        check(ffi::KSPGetPC(coarse, &mut coarse_pc), "KSPGetPC(coarse)")?;
+        let mut kind: *const std::os::raw::c_char = std::ptr::null();
+        check(ffi::PCGetType(coarse_pc, &mut kind), "PCGetType(coarse)")?;
+        let gamg = !kind.is_null() && std::ffi::CStr::from_ptr(kind).to_bytes() == b"gamg";
+        if gamg && bool_option("-mg_coarse_pc_gamg_reuse_interpolation", true)? {
+            let mut operator: ffi::Mat = std::ptr::null_mut();
+            check(
+                ffi::KSPGetOperators(coarse, &mut operator, std::ptr::null_mut()),
+                "KSPGetOperators(coarse)",
+            )?;
+            check(
+                ffi::MatSetNearNullSpace(operator, std::ptr::null_mut()),
+                "MatSetNearNullSpace(coarse, none)",
+            )?;
+        }
+        Ok(())
     }
 }
 

@@ -21,8 +21,6 @@ pub struct DofMap {
     pub tri_nodes: Vec<[u32; 6]>,
     /// Global number of each node's first dof (ux; then uy, then p at a vertex of a mixed mesh).
     pub node_global: Vec<usize>,
-    /// Offset of each node's first dof in the local (owned + ghost) vector.
-    pub node_local: Vec<usize>,
     /// Dofs per vertex node: 2, or 3 with a pressure unknown (mixed u–p elements).
     pub vertex_dofs: usize,
     /// Whether this rank owns the node (and so its two rows).
@@ -114,13 +112,9 @@ impl DofMap {
             .sum();
         let (first_dof, n_global_dofs) = exscan_u64(comm, n_owned_dofs as u64);
         let mut node_global = vec![usize::MAX; node_owned.len()];
-        let mut node_local = Vec::with_capacity(node_owned.len());
         let mut owned_number: HashMap<[u64; 2], u64> = HashMap::with_capacity(node_owned.len());
         let mut next = first_dof;
-        let mut local = 0;
         for (n, &own) in node_owned.iter().enumerate() {
-            node_local.push(local);
-            local += ndof(n);
             if own {
                 node_global[n] = next as usize;
                 owned_number.insert(keys[n], next);
@@ -158,7 +152,6 @@ impl DofMap {
             node_global,
             node_owned,
             node_point,
-            node_local,
             vertex_dofs,
             n_owned_dofs,
             first_dof: first_dof as usize,
@@ -168,6 +161,23 @@ impl DofMap {
 
     pub fn n_nodes(&self) -> usize {
         self.node_global.len()
+    }
+
+    /// Offset of node `n`'s first dof in the local (owned + ghost) vector: the vertex nodes'
+    /// dofs come first, then two per midside node. Computed rather than stored (8 bytes a node,
+    /// under the solve's memory peak).
+    pub fn node_local(&self, n: usize) -> usize {
+        let vertices = self.n_nodes() - self.edges.len();
+        if n < vertices {
+            self.vertex_dofs * n
+        } else {
+            self.vertex_dofs * vertices + 2 * (n - vertices)
+        }
+    }
+
+    /// Length of the local (owned + ghost) vector.
+    pub fn n_local_dofs(&self) -> usize {
+        self.node_local(self.n_nodes())
     }
 
     /// The particles behind node `n`: a vertex's point twice, or an edge node's two ends.
@@ -224,11 +234,7 @@ impl DofMap {
     /// The local vector (every local node's dofs, node order) from this rank's owned entries
     /// of the global vector and the ghost values in [`Self::ghost_globals`] order.
     pub fn local_vector(&self, owned: &[f64], ghosts: &[f64]) -> Vec<f64> {
-        let n_local = self
-            .node_local
-            .last()
-            .map_or(0, |&o| o + self.ndof(self.n_nodes() - 1));
-        let mut local = Vec::with_capacity(n_local);
+        let mut local = Vec::with_capacity(self.n_local_dofs());
         let mut ghost = 0;
         for n in 0..self.n_nodes() {
             let nd = self.ndof(n);
@@ -348,7 +354,6 @@ mod tests {
             edges: vec![[0, 1], [1, 0]],
             tri_nodes: Vec::new(),
             node_global: vec![100, 50, 60, 103],
-            node_local: vec![0, 3, 6, 8],
             vertex_dofs: 3,
             node_owned: vec![true, false, false, true],
             node_point: vec![0, 1, u32::MAX, u32::MAX],

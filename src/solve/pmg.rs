@@ -228,7 +228,6 @@ pub(super) fn one_triangle_dofs(
         edges: vec![[0, 1], [1, 2], [0, 2]],
         tri_nodes: vec![[0, 1, 2, 3, 4, 5]],
         node_global: node_global.to_vec(),
-        node_local: vec![0, 2, 4, 6, 8, 10],
         vertex_dofs: 2,
         node_owned: node_owned.to_vec(),
         node_point: vec![0, 1, 2, u32::MAX, u32::MAX, u32::MAX],

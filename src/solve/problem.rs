@@ -177,7 +177,7 @@ impl<'a> StepProblem<'a> {
     /// The local-vector index of element dof `k` of triangle `t`.
     fn local_dof(&self, t: usize, k: usize) -> usize {
         let (node, c) = self.element_dof(t, k);
-        self.dofs.node_local[node] + c
+        self.dofs.node_local(node) + c
     }
 
     /// Triangle `t`'s global columns in increasing order into `cols` and, for each, its element
@@ -283,10 +283,11 @@ impl<'a> StepProblem<'a> {
 
     /// Step displacement of every local node.
     pub fn node_displacements(&self, local: &[f64]) -> Vec<[f64; 2]> {
-        self.dofs
-            .node_local
-            .iter()
-            .map(|&o| [local[o], local[o + 1]])
+        (0..self.dofs.n_nodes())
+            .map(|n| {
+                let o = self.dofs.node_local(n);
+                [local[o], local[o + 1]]
+            })
             .collect()
     }
 
@@ -297,7 +298,7 @@ impl<'a> StepProblem<'a> {
         (0..self.dofs.n_nodes())
             .map(|n| {
                 if self.dofs.ndof(n) == 3 {
-                    scale * local[self.dofs.node_local[n] + 2]
+                    scale * local[self.dofs.node_local(n) + 2]
                 } else {
                     f64::NAN
                 }
@@ -517,7 +518,7 @@ impl<'a> StepProblem<'a> {
     }
 
     fn node_u(&self, local: &[f64], n: usize) -> [f64; 2] {
-        let o = self.dofs.node_local[n];
+        let o = self.dofs.node_local(n);
         [local[o], local[o + 1]]
     }
 
@@ -754,7 +755,7 @@ impl NonlinearProblem for StepProblem<'_> {
             for (n, c, g) in self.setup.constraints.prescribed() {
                 if self.dofs.node_owned[n] {
                     fa[self.dofs.node_global[n] - first + c] =
-                        diagonal * (local[self.dofs.node_local[n] + c] - g);
+                        diagonal * (local[self.dofs.node_local(n) + c] - g);
                 }
             }
         })
