@@ -120,15 +120,36 @@ fn the_p2_iterative_path_is_a_p_multigrid_unless_asked_for_gamg() {
         args.extend(extra);
         ok(&dir, 2, &args)
     };
-    // The outer PC is PCMG with two levels, a Jacobi smoother on P2 and GAMG on the coarse P1
-    // operator; asked for GAMG, there is no PCMG level at all.
+    // The outer PC is the two-level p-multigrid: a damped Jacobi sweep on P2 before and after
+    // two GAMG cycles on the coarse P1 operator (its options under `mg_coarse_`, as PCMG's).
     let pmg = view(&[]);
-    for want in ["type: mg", "levels=2", "type: gamg"] {
+    for want in [
+        "type: shell",
+        "p-multigrid",
+        "KSP Object: (mg_coarse_)",
+        "type: gamg",
+    ] {
         assert!(pmg.contains(want), "no '{want}' in\n{pmg}");
     }
-    // On a symmetric tangent the P2 smoother is Richardson–Jacobi, damped by the Jacobian's
-    // spectral bound: 2 / (1.1 b) with the elements' Gershgorin bound b, about 0.45 (PETSc's
-    // own default would be 1).
+    let history = || std::fs::read_to_string(dir.join("c.out/history.csv")).expect("history");
+    let cycle_history = history();
+    // On a symmetric tangent the sweeps are damped by the Jacobian's spectral bound:
+    // 2 / (1.1 b) with the elements' Gershgorin bound b, about 0.45 (PETSc's own default
+    // Richardson damping would be 1).
+    let damping = |view: &str| -> f64 {
+        view.split("damping factor=")
+            .nth(1)
+            .and_then(|v| v.split_whitespace().next())
+            .and_then(|v| v.trim_end_matches('.').parse().ok())
+            .unwrap_or_else(|| panic!("no damping in\n{view}"))
+    };
+    assert!(
+        (0.3..0.6).contains(&damping(&pmg)),
+        "damping {}",
+        damping(&pmg)
+    );
+    // An option of PCMG's own cycle brings PCMG back, with the same two levels and the same
+    // damped Richardson–Jacobi smoother: the same history, bit for bit.
     let fine_smoother = |view: &str| {
         let at = view
             .find("KSP Object: (mg_levels_1_)")
@@ -138,17 +159,16 @@ fn the_p2_iterative_path_is_a_p_multigrid_unless_asked_for_gamg() {
             .expect("its PC");
         view[at..at + end].to_string()
     };
-    let smoother = fine_smoother(&pmg);
+    let pcmg = view(&["-pc_mg_log"]);
+    for want in ["type: mg", "levels=2", "type: gamg"] {
+        assert!(pcmg.contains(want), "no '{want}' in\n{pcmg}");
+    }
+    let smoother = fine_smoother(&pcmg);
     assert!(smoother.contains("type: richardson"), "{smoother}");
-    let damping: f64 = smoother
-        .split("damping factor=")
-        .nth(1)
-        .and_then(|v| v.split_whitespace().next())
-        .and_then(|v| v.trim_end_matches('.').parse().ok())
-        .unwrap_or_else(|| panic!("no damping in\n{smoother}"));
-    assert!((0.3..0.6).contains(&damping), "damping {damping}");
-    let after_smoother = &pmg[pmg.find("KSP Object: (mg_levels_1_)").expect("found")..];
+    assert!((0.3..0.6).contains(&damping(&smoother)), "{smoother}");
+    let after_smoother = &pcmg[pcmg.find("KSP Object: (mg_levels_1_)").expect("found")..];
     assert!(after_smoother.contains("type: jacobi"), "{after_smoother}");
+    assert_eq!(history(), cycle_history, "PCMG against the two-level cycle");
     // The cantilever's tangent is symmetric: only its upper triangle is stored, in blocks.
     // Declared unsymmetric, the whole tangent is stored and GMRES replaces CG, with the same
     // history.
@@ -181,6 +201,9 @@ fn the_p2_iterative_path_is_a_p_multigrid_unless_asked_for_gamg() {
         fine_smoother(&chebyshev).contains("type: chebyshev"),
         "{chebyshev}"
     );
+    // Two sweeps are PCMG's too.
+    let two_sweeps = view(&["-mg_levels_ksp_max_it", "2"]);
+    assert!(two_sweeps.contains("type: mg"), "{two_sweeps}");
     // Asked for GAMG, or for any preconditioner on the command line (the p-multigrid's BAIJ
     // tangent would stop GAMG: "No method creategraph for Mat of type seqbaij").
     for asked in [&["-pfem_pmg", "false"][..], &["-pc_type", "gamg"][..]] {
@@ -618,7 +641,7 @@ fn auto_turns_to_the_p_multigrid_where_it_is_faster() {
             .filter_map(|l| l.split_whitespace().nth(3)?.parse::<usize>().ok())
             .sum();
         assert_eq!(dof_count, dofs, "owned dofs summed over the rank table");
-        assert_eq!(view.contains("type: mg"), iterative, "h = {h}:\n{view}");
+        assert_eq!(view.contains("p-multigrid"), iterative, "h = {h}:\n{view}");
         assert_eq!(view.contains("type: cholesky"), !iterative, "h = {h}");
     }
 }

@@ -220,6 +220,35 @@ impl LinearSolver<'_> {
         }
     }
 
+    /// Whether the p-multigrid runs as [`super::two_level`]'s cycle: with the damped
+    /// Richardson–Jacobi smoother ([`Self::damps_jacobi_smoother`]) and no command-line option
+    /// of PCMG's own cycle (its type, cycles, logging, Galerkin products or sweeps), which the
+    /// cycle would not honour; otherwise PCMG runs the same two levels.
+    pub(crate) fn two_level_cycle(&self) -> Result<bool, PetscError> {
+        if !self.damps_jacobi_smoother()? {
+            return Ok(false);
+        }
+        for name in [
+            "-pc_mg_type",
+            "-pc_mg_cycle_type",
+            "-pc_mg_multiplicative_cycles",
+            "-pc_mg_galerkin",
+            "-pc_mg_log",
+            "-pc_mg_smoothup",
+            "-pc_mg_smoothdown",
+        ] {
+            if option_string(name)?.is_some() {
+                return Ok(false);
+            }
+        }
+        for name in ["-mg_levels_ksp_max_it", "-mg_levels_1_ksp_max_it"] {
+            if option_string(name)?.is_some_and(|sweeps| sweeps != "1") {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
+
     /// Whether the fine level's smoother is Richardson–Jacobi damped by the Jacobian's
     /// spectral bound ([`crate::solve::smoother`]): on the p-multigrid with a symmetric
     /// tangent, unless the command line names the smoother, its preconditioner or its damping
@@ -328,6 +357,33 @@ impl LinearSolver<'_> {
                     } else {
                         krylov(ksp, *rtol)?;
                     }
+                    if *symmetric {
+                        // The coarse GAMG's Chebyshev smoothers estimate their eigenvalues by
+                        // CG: GMRES's vectors sat under the memory peak (heaptrack, 30 MB of 886
+                        // at h = 1/128 on 1 rank; the same iteration counts).
+                        default_option("-mg_coarse_mg_levels_esteig_ksp_type", "cg")?;
+                    }
+                    if self.two_level_cycle()? {
+                        let mut coarse_ksp: ffi::KSP = std::ptr::null_mut();
+                        let mut comm = mpi::ffi::RSMPI_COMM_NULL;
+                        check(
+                            ffi::PetscObjectGetComm(ksp as ffi::PetscObject, &mut comm),
+                            "PetscObjectGetComm",
+                        )?;
+                        check(ffi::KSPCreate(comm, &mut coarse_ksp), "KSPCreate(coarse)")?;
+                        // Owned by the cycle from here on, options read as PCMG's would be.
+                        let prefix = cstring("mg_coarse_")?;
+                        let made = check(
+                            ffi::KSPSetOptionsPrefix(coarse_ksp, prefix.as_ptr()),
+                            "KSPSetOptionsPrefix(coarse)",
+                        )
+                        .and_then(|()| configure_coarse(coarse_ksp, coarse));
+                        if let Err(e) = made {
+                            ffi::KSPDestroy(&mut coarse_ksp);
+                            return Err(e);
+                        }
+                        return super::two_level::set(pc, interpolation.raw, coarse_ksp);
+                    }
                     set_pc_type(pc, "mg")?;
                     check(
                         ffi::PCMGSetLevels(pc, 2, std::ptr::null_mut()),
@@ -346,50 +402,15 @@ impl LinearSolver<'_> {
                         ffi::PCMGGetCoarseSolve(pc, &mut coarse_ksp),
                         "PCMGGetCoarseSolve",
                     )?;
-                    check(
-                        ffi::KSPSetOperators(coarse_ksp, coarse.raw, coarse.raw),
-                        "KSPSetOperators(coarse)",
-                    )?;
-                    // Two GAMG cycles on the coarse level (Richardson, a fixed linear
-                    // operator, so CG still sees a symmetric preconditioner): GAMG is the
-                    // weak part of the pair on slender bodies. Cantilever h = 1/64, 5 steps,
-                    // 2 ranks: 688 CG iterations against 904 with one cycle, and with an exact
-                    // coarse solve 101, so the fine smoothing is not what limits it.
-                    set_ksp_type(coarse_ksp, "richardson")?;
-                    check(
-                        ffi::KSPSetTolerances(coarse_ksp, 0.0, 0.0, 1e30, COARSE_CYCLES),
-                        "KSPSetTolerances(coarse)",
-                    )?;
-                    check(
-                        ffi::KSPSetNormType(coarse_ksp, ffi::KSPNormType_KSP_NORM_NONE),
-                        "KSPSetNormType(coarse)",
-                    )?;
-                    let mut coarse_pc: ffi::PC = std::ptr::null_mut();
-                    check(
-                        ffi::KSPGetPC(coarse_ksp, &mut coarse_pc),
-                        "KSPGetPC(coarse)",
-                    )?;
-                    set_pc_type(coarse_pc, "gamg")?;
-                    // The coarse operator is the Galerkin product of each Newton iterate's
-                    // tangent: GAMG aggregates once per increment and only redoes its
-                    // products on the next iterations. Its smoothers then estimate their
-                    // eigenvalues afresh instead of keeping the first aggregation's (a stale
-                    // bound is how reused GAMG became indefinite, native-stack.md pitfall 4).
-                    check(
-                        ffi::PCGAMGSetReuseInterpolation(coarse_pc, ffi::PetscBool_PETSC_TRUE),
-                        "PCGAMGSetReuseInterpolation",
-                    )?;
-                    check(
-                        ffi::PCGAMGSetUseSAEstEig(coarse_pc, ffi::PetscBool_PETSC_FALSE),
-                        "PCGAMGSetUseSAEstEig",
-                    )?;
+                    configure_coarse(coarse_ksp, coarse)?;
                     // Point Jacobi on P2 (PCMG's default smoother is Chebyshev with SOR),
                     // one sweep before and after (two took 30 % longer for 3 % fewer
                     // iterations). Where the tangent is symmetric, Richardson damped by the
                     // Jacobian's own spectral bound (`Snes` sets the damping after every
                     // Jacobian: `super::snes`, `crate::solve::smoother`); elsewhere
                     // Chebyshev, its eigenvalues estimated by GMRES (by CG if the user asks
-                    // for Chebyshev on a symmetric tangent: GMRES keeps 30 vectors).
+                    // for Chebyshev on a symmetric tangent: GMRES keeps 30 vectors). By
+                    // default that damped sweep runs in `super::two_level`'s cycle, not here.
                     default_option("-mg_levels_pc_type", "jacobi")?;
                     default_option("-mg_levels_ksp_max_it", "1")?;
                     if self.damps_jacobi_smoother()? {
@@ -402,10 +423,6 @@ impl LinearSolver<'_> {
                     }
                     if *symmetric {
                         default_option("-mg_levels_esteig_ksp_type", "cg")?;
-                        // Likewise the coarse GAMG's Chebyshev smoothers: their estimators'
-                        // GMRES vectors sat under the memory peak (heaptrack, 30 MB of 886 at
-                        // h = 1/128 on 1 rank; the same iteration counts).
-                        default_option("-mg_coarse_mg_levels_esteig_ksp_type", "cg")?;
                     }
                 }
                 LinearSolver::Schur {
@@ -463,6 +480,52 @@ impl LinearSolver<'_> {
 }
 
 /// GMRES with right preconditioning, so that the tolerance applies to the true residual.
+/// The p-multigrid's coarse solver: two GAMG cycles on the coarse operator `coarse`
+/// (Richardson, a fixed linear operator, so CG still sees a symmetric preconditioner). GAMG is
+/// the weak part of the pair on slender bodies: cantilever h = 1/64, 5 steps, 2 ranks, 688 CG
+/// iterations against 904 with one cycle, and with an exact coarse solve 101, so the fine
+/// smoothing is not what limits it.
+///
+/// # Safety
+/// `coarse_ksp` must be a live KSP.
+unsafe fn configure_coarse(coarse_ksp: ffi::KSP, coarse: &Mat) -> Result<(), PetscError> {
+    // SAFETY: as the caller promises; the operator is referenced by PETSc.
+    unsafe {
+        check(
+            ffi::KSPSetOperators(coarse_ksp, coarse.raw, coarse.raw),
+            "KSPSetOperators(coarse)",
+        )?;
+        set_ksp_type(coarse_ksp, "richardson")?;
+        check(
+            ffi::KSPSetTolerances(coarse_ksp, 0.0, 0.0, 1e30, COARSE_CYCLES),
+            "KSPSetTolerances(coarse)",
+        )?;
+        check(
+            ffi::KSPSetNormType(coarse_ksp, ffi::KSPNormType_KSP_NORM_NONE),
+            "KSPSetNormType(coarse)",
+        )?;
+        let mut coarse_pc: ffi::PC = std::ptr::null_mut();
+        check(
+            ffi::KSPGetPC(coarse_ksp, &mut coarse_pc),
+            "KSPGetPC(coarse)",
+        )?;
+        set_pc_type(coarse_pc, "gamg")?;
+        // The coarse operator is the Galerkin product of each Newton iterate's tangent: GAMG
+        // aggregates once per increment and only redoes its products on the next iterations.
+        // Its smoothers then estimate their eigenvalues afresh instead of keeping the first
+        // aggregation's (a stale bound is how reused GAMG became indefinite, native-stack.md
+        // pitfall 4).
+        check(
+            ffi::PCGAMGSetReuseInterpolation(coarse_pc, ffi::PetscBool_PETSC_TRUE),
+            "PCGAMGSetReuseInterpolation",
+        )?;
+        check(
+            ffi::PCGAMGSetUseSAEstEig(coarse_pc, ffi::PetscBool_PETSC_FALSE),
+            "PCGAMGSetUseSAEstEig",
+        )
+    }
+}
+
 unsafe fn krylov(ksp: ffi::KSP, rtol: Scalar) -> Result<(), PetscError> {
     set_ksp_type(ksp, "gmres")?;
     check(

@@ -12,6 +12,7 @@ pub mod reason;
 pub mod scatter;
 pub mod shell;
 pub mod snes;
+mod two_level;
 pub mod vector;
 
 /// PETSc's integer as the bindings define it (32 or 64 bits by build): every index and count

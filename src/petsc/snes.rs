@@ -4,6 +4,7 @@ use super::init::cstring;
 use super::linear::{bool_option, FactorReuse, LinearSolver};
 use super::matrix::{to_int, Mat, MatRef};
 use super::reason::{Divergence, KspDiverged, SnesDiverged, SolveFailure};
+use super::two_level;
 use super::vector::{PVec, VecRef};
 use mpi::raw::AsRaw;
 use mpi::topology::SimpleCommunicator;
@@ -282,8 +283,16 @@ impl Snes {
     /// hierarchy and the Krylov method's vectors), keeping the configuration; the next solve
     /// sets up again.
     pub fn reset(&mut self) -> Result<(), PetscError> {
-        // SAFETY: live SNES we own; the matrices and vectors it referenced stay owned by us.
-        check(unsafe { ffi::SNESReset(self.raw) }, "SNESReset")
+        let mut ksp: ffi::KSP = std::ptr::null_mut();
+        let mut pc: ffi::PC = std::ptr::null_mut();
+        // SAFETY: live SNES we own; KSP and PC are borrowed from it; the matrices and vectors
+        // it referenced stay owned by us. The two-level cycle has no reset of its own.
+        unsafe {
+            check(ffi::SNESGetKSP(self.raw, &mut ksp), "SNESGetKSP")?;
+            check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
+            two_level::reset(pc)?;
+            check(ffi::SNESReset(self.raw), "SNESReset")
+        }
     }
 }
 
@@ -410,6 +419,9 @@ fn damp_smoother(snes: ffi::SNES, damping: f64) -> Result<(), PetscError> {
     unsafe {
         check(ffi::SNESGetKSP(snes, &mut ksp), "SNESGetKSP")?;
         check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
+        if two_level::is_two_level(pc)? {
+            return two_level::set_damping(pc, damping);
+        }
         check(
             ffi::PCMGGetSmoother(pc, 1, &mut smoother),
             "PCMGGetSmoother",
@@ -473,13 +485,17 @@ fn share_work_vector(snes: ffi::SNES, x: VecRef<'_>) -> Result<(), PetscError> {
     unsafe {
         check(ffi::SNESGetKSP(snes, &mut ksp), "SNESGetKSP")?;
         check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
-        // Level 1 is the fine level only in the two-level hierarchy we build.
-        let mut levels: ffi::PetscInt = 0;
-        check(ffi::PCMGGetLevels(pc, &mut levels), "PCMGGetLevels")?;
-        if levels != 2 {
-            return Ok(());
+        if two_level::is_two_level(pc)? {
+            two_level::set_residual(pc, shared.raw)?;
+        } else {
+            // Level 1 is the fine level only in the two-level hierarchy we build.
+            let mut levels: ffi::PetscInt = 0;
+            check(ffi::PCMGGetLevels(pc, &mut levels), "PCMGGetLevels")?;
+            if levels != 2 {
+                return Ok(());
+            }
+            check(ffi::PCMGSetR(pc, 1, shared.raw), "PCMGSetR")?;
         }
-        check(ffi::PCMGSetR(pc, 1, shared.raw), "PCMGSetR")?;
         for _ in 0..2 {
             check(
                 ffi::PetscObjectReference(shared.raw as ffi::PetscObject),
@@ -513,10 +529,14 @@ fn set_up_coarse_solver(snes: ffi::SNES) -> Result<(), PetscError> {
     unsafe {
         check(ffi::SNESGetKSP(snes, &mut ksp), "SNESGetKSP")?;
         check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
-        check(
-            ffi::PCMGGetCoarseSolve(pc, &mut coarse),
-            "PCMGGetCoarseSolve",
-        )?;
+        if two_level::is_two_level(pc)? {
+            coarse = two_level::coarse_solver(pc)?;
+        } else {
+            check(
+                ffi::PCMGGetCoarseSolve(pc, &mut coarse),
+                "PCMGGetCoarseSolve",
+            )?;
+        }
         // Its options are read first, as the multigrid's own set-up would read them.
         check(ffi::KSPSetFromOptions(coarse), "KSPSetFromOptions(coarse)")?;
         check(ffi::KSPSetUp(coarse), "KSPSetUp(coarse)")?;
