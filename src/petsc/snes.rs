@@ -281,16 +281,14 @@ impl Snes {
 
     /// Collective. Frees what the last solve set up (work vectors, the preconditioner's
     /// hierarchy and the Krylov method's vectors), keeping the configuration; the next solve
-    /// sets up again.
+    /// sets up again. The end of an increment's solver: the p-multigrid's coarse operator lost
+    /// its rigid-body modes after GAMG's first aggregation, so a solve after a reset would
+    /// aggregate without them (each increment makes its solver afresh).
     pub fn reset(&mut self) -> Result<(), PetscError> {
-        let mut ksp: ffi::KSP = std::ptr::null_mut();
-        let mut pc: ffi::PC = std::ptr::null_mut();
-        // SAFETY: live SNES we own; KSP and PC are borrowed from it; the matrices and vectors
-        // it referenced stay owned by us. The two-level cycle has no reset of its own.
+        // SAFETY: live SNES we own; its PC is borrowed from it; the matrices and vectors it
+        // referenced stay owned by us. The two-level cycle has no reset of its own.
         unsafe {
-            check(ffi::SNESGetKSP(self.raw, &mut ksp), "SNESGetKSP")?;
-            check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
-            two_level::reset(pc)?;
+            two_level::reset(preconditioner(self.raw)?)?;
             check(ffi::SNESReset(self.raw), "SNESReset")
         }
     }
@@ -409,16 +407,28 @@ unsafe extern "C" fn jacobian_cb(
     }
 }
 
-/// Sets the Richardson damping of the p-multigrid's fine smoother (level 1) for the next
-/// linear solve.
-fn damp_smoother(snes: ffi::SNES, damping: f64) -> Result<(), PetscError> {
+/// The preconditioner of `snes`'s linear solver, borrowed from it.
+///
+/// # Safety
+/// `snes` must be live; the PC must not outlive it.
+unsafe fn preconditioner(snes: ffi::SNES) -> Result<ffi::PC, PetscError> {
     let mut ksp: ffi::KSP = std::ptr::null_mut();
     let mut pc: ffi::PC = std::ptr::null_mut();
-    let mut smoother: ffi::KSP = std::ptr::null_mut();
-    // SAFETY: the SNES is live during its callback; KSP, PC and smoother are borrowed from it.
+    // SAFETY: as the caller promises.
     unsafe {
         check(ffi::SNESGetKSP(snes, &mut ksp), "SNESGetKSP")?;
         check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
+    }
+    Ok(pc)
+}
+
+/// Sets the Richardson damping of the p-multigrid's fine smoother (level 1) for the next
+/// linear solve.
+fn damp_smoother(snes: ffi::SNES, damping: f64) -> Result<(), PetscError> {
+    let mut smoother: ffi::KSP = std::ptr::null_mut();
+    // SAFETY: the SNES is live during its callback; PC and smoother are borrowed from it.
+    unsafe {
+        let pc = preconditioner(snes)?;
         if two_level::is_two_level(pc)? {
             return two_level::set_damping(pc, damping);
         }
@@ -477,14 +487,11 @@ fn share_work_vector(snes: ffi::SNES, x: VecRef<'_>) -> Result<(), PetscError> {
         return Ok(());
     }
     let shared = x.duplicate()?;
-    let mut ksp: ffi::KSP = std::ptr::null_mut();
-    let mut pc: ffi::PC = std::ptr::null_mut();
-    // SAFETY: live SNES; KSP and PC are borrowed from it. The multigrid takes its own
-    // reference to the vector; the line search takes none but destroys both of its
-    // vectors on reset, so it is given one reference for each. Ours goes with `shared`.
+    // SAFETY: live SNES; its PC is borrowed from it. The multigrid takes its own reference to
+    // the vector; the line search takes none but destroys both of its vectors on reset, so it
+    // is given one reference for each. Ours goes with `shared`.
     unsafe {
-        check(ffi::SNESGetKSP(snes, &mut ksp), "SNESGetKSP")?;
-        check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
+        let pc = preconditioner(snes)?;
         if two_level::is_two_level(pc)? {
             two_level::set_residual(pc, shared.raw)?;
         } else {
@@ -522,13 +529,10 @@ fn share_work_vector(snes: ffi::SNES, x: VecRef<'_>) -> Result<(), PetscError> {
 /// peak of the iterative path, and those six vectors need not sit under it. The outer set-up
 /// that follows finds the coarse solver set up for this operator and leaves it.
 fn set_up_coarse_solver(snes: ffi::SNES) -> Result<(), PetscError> {
-    let mut ksp: ffi::KSP = std::ptr::null_mut();
-    let mut pc: ffi::PC = std::ptr::null_mut();
     let mut coarse: ffi::KSP = std::ptr::null_mut();
-    // SAFETY: the SNES is live during its callback; KSP, PC and coarse KSP are borrowed from it.
+    // SAFETY: the SNES is live during its callback; PC and coarse KSP are borrowed from it.
     unsafe {
-        check(ffi::SNESGetKSP(snes, &mut ksp), "SNESGetKSP")?;
-        check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
+        let pc = preconditioner(snes)?;
         if two_level::is_two_level(pc)? {
             coarse = two_level::coarse_solver(pc)?;
         } else {
@@ -549,13 +553,8 @@ fn set_up_coarse_solver(snes: ffi::SNES) -> Result<(), PetscError> {
         check(ffi::PCGetType(coarse_pc, &mut kind), "PCGetType(coarse)")?;
         let gamg = !kind.is_null() && std::ffi::CStr::from_ptr(kind).to_bytes() == b"gamg";
         if gamg && bool_option("-mg_coarse_pc_gamg_reuse_interpolation", true)? {
-            let mut operator: ffi::Mat = std::ptr::null_mut();
             check(
-                ffi::KSPGetOperators(coarse, &mut operator, std::ptr::null_mut()),
-                "KSPGetOperators(coarse)",
-            )?;
-            check(
-                ffi::MatSetNearNullSpace(operator, std::ptr::null_mut()),
+                ffi::MatSetNearNullSpace(two_level::coarse_operator(coarse)?, std::ptr::null_mut()),
                 "MatSetNearNullSpace(coarse, none)",
             )?;
         }

@@ -171,11 +171,7 @@ pub(super) unsafe fn reset(pc: ffi::PC) -> Result<(), PetscError> {
     unsafe {
         if let Some(c) = context(pc)? {
             // KSPReset also drops the operator, which the next increment's set-up needs.
-            let mut operator: ffi::Mat = std::ptr::null_mut();
-            check(
-                ffi::KSPGetOperators(c.coarse, &mut operator, std::ptr::null_mut()),
-                "KSPGetOperators(coarse)",
-            )?;
+            let mut operator = coarse_operator(c.coarse)?;
             check(
                 ffi::PetscObjectReference(operator as ffi::PetscObject),
                 "PetscObjectReference(coarse operator)",
@@ -254,6 +250,20 @@ unsafe fn with_cycle(
     }
 }
 
+/// The operator of the coarse solver `coarse`, borrowed from it.
+///
+/// # Safety
+/// `coarse` must be live.
+pub(super) unsafe fn coarse_operator(coarse: ffi::KSP) -> Result<ffi::Mat, PetscError> {
+    let mut operator: ffi::Mat = std::ptr::null_mut();
+    // SAFETY: as the caller promises.
+    check(
+        unsafe { ffi::KSPGetOperators(coarse, &mut operator, std::ptr::null_mut()) },
+        "KSPGetOperators(coarse)",
+    )?;
+    Ok(operator)
+}
+
 /// The fine operator (PETSc's preconditioning matrix) of `pc`.
 unsafe fn fine_operator(pc: ffi::PC) -> Result<ffi::Mat, PetscError> {
     let mut pmat: ffi::Mat = std::ptr::null_mut();
@@ -287,13 +297,12 @@ unsafe extern "C" fn setup_cb(pc: ffi::PC) -> ffi::PetscErrorCode {
             check(ffi::MatGetDiagonal(a, c.inverse_diagonal), "MatGetDiagonal")?;
             check(ffi::VecReciprocal(c.inverse_diagonal), "VecReciprocal")?;
             if c.coarse_rhs.is_null() {
-                let mut coarse_operator: ffi::Mat = std::ptr::null_mut();
                 check(
-                    ffi::KSPGetOperators(c.coarse, &mut coarse_operator, std::ptr::null_mut()),
-                    "KSPGetOperators(coarse)",
-                )?;
-                check(
-                    ffi::MatCreateVecs(coarse_operator, &mut c.coarse_solution, &mut c.coarse_rhs),
+                    ffi::MatCreateVecs(
+                        coarse_operator(c.coarse)?,
+                        &mut c.coarse_solution,
+                        &mut c.coarse_rhs,
+                    ),
                     "MatCreateVecs(coarse)",
                 )?;
             }
@@ -325,19 +334,12 @@ unsafe extern "C" fn apply_cb(pc: ffi::PC, b: ffi::Vec, x: ffi::Vec) -> ffi::Pet
                 ffi::KSPSolve(c.coarse, c.coarse_rhs, c.coarse_solution),
                 "KSPSolve(coarse)",
             )?;
-            // A failed coarse solve fails the preconditioner, as PCMG reports it: the Krylov
-            // method then stops with DIVERGED_PC_FAILED instead of iterating on garbage.
-            let mut reason: ffi::KSPConvergedReason = 0;
+            // A failed coarse solve fails the preconditioner as PCMG reports it: the solution
+            // is marked (Inf) and the outer Krylov method stops with DIVERGED_PC_FAILED.
             check(
-                ffi::KSPGetConvergedReason(c.coarse, &mut reason),
-                "KSPGetConvergedReason(coarse)",
+                ffi::KSPCheckSolve(c.coarse, pc, c.coarse_solution),
+                "KSPCheckSolve(coarse)",
             )?;
-            if reason < 0 {
-                check(
-                    ffi::PCSetFailedReason(pc, ffi::PCFailedReason_PC_SUBPC_ERROR),
-                    "PCSetFailedReason",
-                )?;
-            }
             check(
                 ffi::MatMultAdd(c.interpolation, c.coarse_solution, x, x),
                 "MatMultAdd(interpolation)",
