@@ -296,6 +296,29 @@ unsafe extern "C" fn setup_cb(pc: ffi::PC) -> ffi::PetscErrorCode {
             }
             check(ffi::MatGetDiagonal(a, c.inverse_diagonal), "MatGetDiagonal")?;
             check(ffi::VecReciprocal(c.inverse_diagonal), "VecReciprocal")?;
+            // As PCJACOBI: a zero diagonal entry (left zero by the reciprocal) counts as one.
+            // VecGetArray lends the n local entries until VecRestoreArray.
+            let mut n: ffi::PetscInt = 0;
+            check(
+                ffi::VecGetLocalSize(c.inverse_diagonal, &mut n),
+                "VecGetLocalSize",
+            )?;
+            let mut values: *mut ffi::PetscScalar = std::ptr::null_mut();
+            check(
+                ffi::VecGetArray(c.inverse_diagonal, &mut values),
+                "VecGetArray",
+            )?;
+            if n > 0 {
+                for v in std::slice::from_raw_parts_mut(values, n as usize) {
+                    if *v == 0.0 {
+                        *v = 1.0;
+                    }
+                }
+            }
+            check(
+                ffi::VecRestoreArray(c.inverse_diagonal, &mut values),
+                "VecRestoreArray",
+            )?;
             if c.coarse_rhs.is_null() {
                 check(
                     ffi::MatCreateVecs(
