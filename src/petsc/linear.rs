@@ -479,7 +479,6 @@ impl LinearSolver<'_> {
     }
 }
 
-/// GMRES with right preconditioning, so that the tolerance applies to the true residual.
 /// The p-multigrid's coarse solver: two GAMG cycles on the coarse operator `coarse`
 /// (Richardson, a fixed linear operator, so CG still sees a symmetric preconditioner). GAMG is
 /// the weak part of the pair on slender bodies: cantilever h = 1/64, 5 steps, 2 ranks, 688 CG
@@ -526,6 +525,7 @@ unsafe fn configure_coarse(coarse_ksp: ffi::KSP, coarse: &Mat) -> Result<(), Pet
     }
 }
 
+/// GMRES with right preconditioning, so that the tolerance applies to the true residual.
 unsafe fn krylov(ksp: ffi::KSP, rtol: Scalar) -> Result<(), PetscError> {
     set_ksp_type(ksp, "gmres")?;
     check(

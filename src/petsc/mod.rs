@@ -24,6 +24,22 @@ pub type Int = ffi::PetscInt;
 pub type Scalar = ffi::PetscScalar;
 const _: () = assert!(std::mem::size_of::<Scalar>() == std::mem::size_of::<f64>());
 
+/// Whether the PETSc object `object` (a KSP, PC, line search, ...) has the type `name`
+/// (`PetscObjectTypeCompare`).
+///
+/// # Safety
+/// `object` must be a live PETSc object.
+unsafe fn has_type(object: ffi::PetscObject, name: &str) -> Result<bool, PetscError> {
+    let name = init::cstring(name)?;
+    let mut same = ffi::PetscBool_PETSC_FALSE;
+    // SAFETY: as the caller promises; the name outlives the call.
+    error::check(
+        unsafe { ffi::PetscObjectTypeCompare(object, name.as_ptr(), &mut same) },
+        "PetscObjectTypeCompare",
+    )?;
+    Ok(same == ffi::PetscBool_PETSC_TRUE)
+}
+
 pub use error::PetscError;
 pub use index_set::IndexSet;
 pub use init::Petsc;

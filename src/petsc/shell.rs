@@ -101,14 +101,24 @@ unsafe fn with_operator(
         return code;
     }
     let op: &Context = unsafe { &*(ctx as *const Context) };
-    match catch_unwind(AssertUnwindSafe(|| f(op.as_ref()))) {
+    run_callback("shell matrix", || f(op.as_ref()))
+}
+
+/// Runs a PETSc callback's body `f`: an error or panic is printed on this rank under `what`
+/// (PETSc's error code alone would lose the message) and becomes PETSc's user-error code, so
+/// that no panic unwinds into C.
+pub(super) fn run_callback(
+    what: &str,
+    f: impl FnOnce() -> Result<(), PetscError>,
+) -> ffi::PetscErrorCode {
+    match catch_unwind(AssertUnwindSafe(f)) {
         Ok(Ok(())) => 0,
         Ok(Err(e)) => {
-            eprintln!("pfem-mpi: shell matrix: {e}");
+            eprintln!("pfem-mpi: {what}: {e}");
             PETSC_ERR_USER
         }
         Err(_) => {
-            eprintln!("pfem-mpi: shell matrix: the operator panicked");
+            eprintln!("pfem-mpi: {what}: panicked");
             PETSC_ERR_USER
         }
     }

@@ -452,16 +452,10 @@ fn damp_smoother(snes: ffi::SNES, damping: f64) -> Result<(), PetscError> {
 /// memory peak.
 fn share_work_vector(snes: ffi::SNES, x: VecRef<'_>) -> Result<(), PetscError> {
     let mut ls: ffi::SNESLineSearch = std::ptr::null_mut();
-    let mut kind: *const std::os::raw::c_char = std::ptr::null();
-    // SAFETY: the SNES is live during its callback; its line search is borrowed; the type
-    // name is PETSc's.
+    // SAFETY: the SNES is live during its callback; its line search is borrowed.
     let basic = unsafe {
         check(ffi::SNESGetLineSearch(snes, &mut ls), "SNESGetLineSearch")?;
-        check(
-            ffi::SNESLineSearchGetType(ls, &mut kind),
-            "SNESLineSearchGetType",
-        )?;
-        !kind.is_null() && std::ffi::CStr::from_ptr(kind).to_bytes() == b"basic"
+        super::has_type(ls as ffi::PetscObject, "basic")?
     };
     if !basic {
         return Ok(());
@@ -486,21 +480,24 @@ fn share_work_vector(snes: ffi::SNES, x: VecRef<'_>) -> Result<(), PetscError> {
     if !w.is_null() {
         return Ok(());
     }
-    let shared = x.duplicate()?;
     // SAFETY: live SNES; its PC is borrowed from it. The multigrid takes its own reference to
     // the vector; the line search takes none but destroys both of its vectors on reset, so it
     // is given one reference for each. Ours goes with `shared`.
     unsafe {
         let pc = preconditioner(snes)?;
-        if two_level::is_two_level(pc)? {
-            two_level::set_residual(pc, shared.raw)?;
-        } else {
+        let own_cycle = two_level::is_two_level(pc)?;
+        if !own_cycle {
             // Level 1 is the fine level only in the two-level hierarchy we build.
             let mut levels: ffi::PetscInt = 0;
             check(ffi::PCMGGetLevels(pc, &mut levels), "PCMGGetLevels")?;
             if levels != 2 {
                 return Ok(());
             }
+        }
+        let shared = x.duplicate()?;
+        if own_cycle {
+            two_level::set_residual(pc, shared.raw)?;
+        } else {
             check(ffi::PCMGSetR(pc, 1, shared.raw), "PCMGSetR")?;
         }
         for _ in 0..2 {
@@ -549,10 +546,9 @@ fn set_up_coarse_solver(snes: ffi::SNES) -> Result<(), PetscError> {
         // the modes again, so their vectors are freed (three of the coarse level).
         let mut coarse_pc: ffi::PC = std::ptr::null_mut();
         check(ffi::KSPGetPC(coarse, &mut coarse_pc), "KSPGetPC(coarse)")?;
-        let mut kind: *const std::os::raw::c_char = std::ptr::null();
-        check(ffi::PCGetType(coarse_pc, &mut kind), "PCGetType(coarse)")?;
-        let gamg = !kind.is_null() && std::ffi::CStr::from_ptr(kind).to_bytes() == b"gamg";
-        if gamg && bool_option("-mg_coarse_pc_gamg_reuse_interpolation", true)? {
+        if super::has_type(coarse_pc as ffi::PetscObject, "gamg")?
+            && bool_option("-mg_coarse_pc_gamg_reuse_interpolation", true)?
+        {
             check(
                 ffi::MatSetNearNullSpace(two_level::coarse_operator(coarse)?, std::ptr::null_mut()),
                 "MatSetNearNullSpace(coarse, none)",

@@ -1,16 +1,15 @@
 //! The p-multigrid's V-cycle as one preconditioner (PCSHELL): a damped Jacobi sweep on the P2
 //! level before and after a coarse correction through the P1 → P2 interpolation. It is the
-//! cycle PCMG runs with a Richardson–Jacobi smoother of one sweep, step for step, without
-//! PCMG's price in vectors and products of the fine level: PCMG keeps a residual, the
-//! Richardson smoother two work vectors and Jacobi its diagonal, and its first sweep multiplies
-//! the zero initial iterate by the tangent. Here the diagonal's inverse and one residual (which
-//! the full-step line search borrows between applications) are all, and a cycle takes two
-//! products with the tangent instead of three.
+//! cycle PCMG runs with a Richardson–Jacobi smoother of one sweep, step for step (the same
+//! products with the tangent, the same history bit for bit), without PCMG's price in vectors
+//! of the fine level: PCMG keeps a residual, the Richardson smoother two work vectors and
+//! Jacobi its diagonal. Here the diagonal's inverse and one residual (which the full-step line
+//! search borrows between applications) are all.
 
 use super::error::{check, PetscError};
 use super::ffi;
+use super::vector::VecRef;
 use std::ffi::c_void;
-use std::panic::{catch_unwind, AssertUnwindSafe};
 
 const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
 
@@ -26,6 +25,18 @@ struct TwoLevel {
     coarse_solution: ffi::Vec,
     /// Richardson's damping ω of the Jacobi sweeps.
     damping: f64,
+}
+
+impl TwoLevel {
+    /// The vectors the set-ups make (null until then).
+    fn vectors(&mut self) -> [&mut ffi::Vec; 4] {
+        [
+            &mut self.inverse_diagonal,
+            &mut self.residual,
+            &mut self.coarse_rhs,
+            &mut self.coarse_solution,
+        ]
+    }
 }
 
 /// Collective. Makes `pc` the two-level cycle with `interpolation` (P1 → P2, referenced) and
@@ -85,12 +96,10 @@ pub(super) unsafe fn set(
 /// # Safety
 /// `pc` must be live; the borrow must end before the preconditioner is destroyed.
 unsafe fn context<'a>(pc: ffi::PC) -> Result<Option<&'a mut TwoLevel>, PetscError> {
-    let mut kind: *const std::os::raw::c_char = std::ptr::null();
     // SAFETY: live PC; a shell's context is only ever set by `set` (no shell is made from
     // the command line), so it is a live `TwoLevel`.
     unsafe {
-        check(ffi::PCGetType(pc, &mut kind), "PCGetType")?;
-        if kind.is_null() || std::ffi::CStr::from_ptr(kind).to_bytes() != b"shell" {
+        if !super::has_type(pc as ffi::PetscObject, "shell")? {
             return Ok(None);
         }
         let mut raw: *mut c_void = std::ptr::null_mut();
@@ -184,12 +193,7 @@ pub(super) unsafe fn reset(pc: ffi::PC) -> Result<(), PetscError> {
             });
             ffi::MatDestroy(&mut operator);
             reset?;
-            for v in [
-                &mut c.inverse_diagonal,
-                &mut c.residual,
-                &mut c.coarse_rhs,
-                &mut c.coarse_solution,
-            ] {
+            for v in c.vectors() {
                 check(ffi::VecDestroy(v), "VecDestroy")?;
             }
         }
@@ -213,12 +217,7 @@ unsafe fn release(mut c: TwoLevel) {
     unsafe {
         ffi::MatDestroy(&mut c.interpolation);
         ffi::KSPDestroy(&mut c.coarse);
-        for v in [
-            &mut c.inverse_diagonal,
-            &mut c.residual,
-            &mut c.coarse_rhs,
-            &mut c.coarse_solution,
-        ] {
+        for v in c.vectors() {
             ffi::VecDestroy(v);
         }
     }
@@ -230,24 +229,13 @@ unsafe fn with_cycle(
     pc: ffi::PC,
     f: impl FnOnce(&mut TwoLevel) -> Result<(), PetscError>,
 ) -> ffi::PetscErrorCode {
-    let outcome = catch_unwind(AssertUnwindSafe(|| {
+    super::shell::run_callback("p-multigrid", || {
         // SAFETY: PETSc calls back with the live shell `set` made.
         match unsafe { context(pc) }? {
             Some(c) => f(c),
             None => Err(not_two_level()),
         }
-    }));
-    match outcome {
-        Ok(Ok(())) => 0,
-        Ok(Err(e)) => {
-            eprintln!("pfem-mpi: p-multigrid: {e}");
-            PETSC_ERR_USER
-        }
-        Err(_) => {
-            eprintln!("pfem-mpi: p-multigrid: panicked");
-            PETSC_ERR_USER
-        }
-    }
+    })
 }
 
 /// The operator of the coarse solver `coarse`, borrowed from it.
@@ -297,28 +285,11 @@ unsafe extern "C" fn setup_cb(pc: ffi::PC) -> ffi::PetscErrorCode {
             check(ffi::MatGetDiagonal(a, c.inverse_diagonal), "MatGetDiagonal")?;
             check(ffi::VecReciprocal(c.inverse_diagonal), "VecReciprocal")?;
             // As PCJACOBI: a zero diagonal entry (left zero by the reciprocal) counts as one.
-            // VecGetArray lends the n local entries until VecRestoreArray.
-            let mut n: ffi::PetscInt = 0;
-            check(
-                ffi::VecGetLocalSize(c.inverse_diagonal, &mut n),
-                "VecGetLocalSize",
-            )?;
-            let mut values: *mut ffi::PetscScalar = std::ptr::null_mut();
-            check(
-                ffi::VecGetArray(c.inverse_diagonal, &mut values),
-                "VecGetArray",
-            )?;
-            if n > 0 {
-                for v in std::slice::from_raw_parts_mut(values, n as usize) {
-                    if *v == 0.0 {
-                        *v = 1.0;
-                    }
+            VecRef::lent(c.inverse_diagonal).write(|d| {
+                for v in d.iter_mut().filter(|v| **v == 0.0) {
+                    *v = 1.0;
                 }
-            }
-            check(
-                ffi::VecRestoreArray(c.inverse_diagonal, &mut values),
-                "VecRestoreArray",
-            )?;
+            })?;
             if c.coarse_rhs.is_null() {
                 check(
                     ffi::MatCreateVecs(
@@ -336,7 +307,7 @@ unsafe extern "C" fn setup_cb(pc: ffi::PC) -> ffi::PetscErrorCode {
 
 /// Collective. x = V-cycle(b): a damped Jacobi sweep from zero, the coarse correction of its
 /// residual, a second sweep. The same operations, in the same order, as PCMG's multiplicative
-/// cycle with a one-sweep Richardson–Jacobi smoother, less its product with the zero iterate.
+/// cycle with a one-sweep Richardson–Jacobi smoother.
 unsafe extern "C" fn apply_cb(pc: ffi::PC, b: ffi::Vec, x: ffi::Vec) -> ffi::PetscErrorCode {
     // SAFETY: PETSc keeps b and x alive during the callback; the cycle's own vectors are live.
     unsafe {
