@@ -300,6 +300,80 @@ fn nearly_incompressible_elastic_block_converges_with_the_field_split() {
     );
 }
 
+#[test]
+fn the_field_split_holds_a_yielded_block_through_its_exact_zone() {
+    let dir = workdir("iterative-yield-zone");
+    // block-compression yields everywhere from step 2 on: the displacement block's flow
+    // direction has no stiffness at any Gauss point.
+    for ranks in [1, 2] {
+        let (diff, (newton, linear)) =
+            direct_against_iterative(&dir, "block-compression", &[], ranks, 8, &[]);
+        println!("block-compression, {ranks} ranks: max relative difference {diff:.2e}, {newton} Newton and {linear} linear iterations");
+        assert!(diff < 1e-6, "{ranks} ranks: {diff:e}");
+        // Measured 5.4 per Newton iteration over the 100 steps (step 1, elastic: 39).
+        assert!(
+            linear > newton && linear <= 12 * newton,
+            "{ranks} ranks: {linear} linear iterations for {newton} Newton iterations"
+        );
+    }
+    // The zone is the block's preconditioner, and at step 2 it holds every row.
+    let view = ok(
+        &dir,
+        1,
+        &[
+            "iterative.h5",
+            "--out",
+            "view",
+            "--until-step",
+            "2",
+            "--",
+            "-ksp_view",
+        ],
+    );
+    let sizes: Vec<(usize, usize)> = view
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("yielded zone: "))
+        .map(|l| {
+            let w: Vec<&str> = l.split(' ').collect();
+            (
+                w[0].parse().expect("zone rows"),
+                w[2].parse().expect("rows"),
+            )
+        })
+        .collect();
+    assert!(
+        sizes
+            .first()
+            .is_some_and(|&(zone, rows)| zone > 0 && zone < rows),
+        "step 1 yields at the platens' corners only: {sizes:?}"
+    );
+    assert!(
+        sizes.last().is_some_and(|&(zone, rows)| zone == rows),
+        "step 2 yields everywhere: {sizes:?}"
+    );
+    // Without it, GAMG alone does not converge at yield: the step is cut to failure.
+    let out = common::run(
+        &dir,
+        1,
+        &[
+            "iterative.h5",
+            "--out",
+            "gamg",
+            "--until-step",
+            "2",
+            "--",
+            "-pfem_yield_zone",
+            "false",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("step 2") && stderr.contains("DIVERGED_ITS"),
+        "{stderr}"
+    );
+}
+
 /// A P2 mesh of a distorted 3 x 2 patch of squares cut into triangles: node coordinates
 /// (vertices, then midside nodes) and the 6 nodes of every triangle.
 fn patch() -> (Vec<[f64; 2]>, Vec<[usize; 6]>) {

@@ -49,10 +49,12 @@ pub enum LinearSolver<'a> {
         coarse: &'a Mat,
     },
     /// Right-preconditioned GMRES with an upper block-triangular Schur-complement field split,
-    /// for the mixed P2–P1 saddle point: GAMG on the displacement block (its index set carries
-    /// the rigid-body near-null space), and on the Schur complement `pressure_mass`, the
-    /// pressure mass matrix scaled by −1/G (spectrally equivalent to the Schur complement of
-    /// a nearly incompressible solid; a Jacobi sweep inverts it well enough).
+    /// for the mixed P2–P1 saddle point: on the displacement block GAMG (its index set carries
+    /// the rigid-body near-null space) followed by an exact solve on the rows of the yielded
+    /// triangles ([`super::yield_zone`]; GAMG alone cannot hold a yielded block), and on the
+    /// Schur complement `pressure_mass`, the pressure mass matrix scaled by −1/G (spectrally
+    /// equivalent to the Schur complement of a nearly incompressible solid; a Jacobi sweep
+    /// inverts it well enough).
     Schur {
         rtol: Scalar,
         displacement: &'a IndexSet,
@@ -442,6 +444,12 @@ impl LinearSolver<'_> {
                         ffi::PCFieldSplitSetIS(pc, p.as_ptr(), pressure.raw),
                         "PCFieldSplitSetIS(p)",
                     )?;
+                    // The split's inner solvers exist from here, but the Schur type hands
+                    // them out only once set up: the displacement block's is taken now.
+                    let zone = yield_zone_from_options()?;
+                    if zone {
+                        install_yield_zone(pc, displacement)?;
+                    }
                     check(
                         ffi::PCFieldSplitSetType(pc, ffi::PCCompositeType_PC_COMPOSITE_SCHUR),
                         "PCFieldSplitSetType",
@@ -463,9 +471,11 @@ impl LinearSolver<'_> {
                     )?;
                     // The split's inner solvers exist only once the PC is set up, so their
                     // defaults go to the options database, where the command line wins.
+                    if !zone {
+                        default_option("-fieldsplit_u_pc_type", "gamg")?;
+                    }
                     for (name, value) in [
                         ("-fieldsplit_u_ksp_type", "preonly"),
-                        ("-fieldsplit_u_pc_type", "gamg"),
                         ("-fieldsplit_u_pc_gamg_reuse_interpolation", "false"),
                         ("-fieldsplit_p_ksp_type", "preonly"),
                         ("-fieldsplit_p_pc_type", "jacobi"),
@@ -476,6 +486,53 @@ impl LinearSolver<'_> {
             }
         }
         Ok(())
+    }
+}
+
+/// Whether the field split's displacement block is preconditioned by the yield zone
+/// ([`super::yield_zone`]): unless the PETSc option `-pfem_yield_zone false` (or `0`) is
+/// given or the command line names the block's own preconditioner (`-fieldsplit_u_pc_type`).
+fn yield_zone_from_options() -> Result<bool, PetscError> {
+    Ok(bool_option("-pfem_yield_zone", true)? && option_string("-fieldsplit_u_pc_type")?.is_none())
+}
+
+/// Collective. Makes the displacement block's preconditioner of the field split `pc` (before
+/// its type is Schur) the yield zone.
+///
+/// # Safety
+/// `pc` must be a live field split with its two fields set.
+unsafe fn install_yield_zone(pc: ffi::PC, displacement: &IndexSet) -> Result<(), PetscError> {
+    let mut n: ffi::PetscInt = 0;
+    let mut sub: *mut ffi::KSP = std::ptr::null_mut();
+    // SAFETY: as the caller promises; PETSc allocates the array of borrowed KSPs, freed here.
+    unsafe {
+        check(
+            ffi::PCFieldSplitGetSubKSP(pc, &mut n, &mut sub),
+            "PCFieldSplitGetSubKSP",
+        )?;
+        let first = if n > 0 && !sub.is_null() {
+            Some(*sub)
+        } else {
+            None
+        };
+        let (func, file) = (cstring("install_yield_zone")?, cstring(file!())?);
+        let freed = ffi::PetscFreeA(
+            1,
+            line!() as std::os::raw::c_int,
+            func.as_ptr(),
+            file.as_ptr(),
+            &mut sub as *mut *mut ffi::KSP as *mut std::ffi::c_void,
+        );
+        check(freed, "PetscFree")?;
+        let Some(ksp) = first else {
+            return Err(PetscError {
+                code: 83,
+                message: "the field split has no displacement block".into(),
+            });
+        };
+        let mut block_pc: ffi::PC = std::ptr::null_mut();
+        check(ffi::KSPGetPC(ksp, &mut block_pc), "KSPGetPC(u)")?;
+        super::yield_zone::install(block_pc, displacement.raw, pc)
     }
 }
 

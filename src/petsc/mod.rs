@@ -14,6 +14,7 @@ pub mod shell;
 pub mod snes;
 mod two_level;
 pub mod vector;
+mod yield_zone;
 
 /// PETSc's integer as the bindings define it (32 or 64 bits by build): every index and count
 /// handed to PETSc has this type, converted with a check ([`matrix::to_int`]).

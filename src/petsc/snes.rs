@@ -6,6 +6,7 @@ use super::matrix::{to_int, Mat, MatRef};
 use super::reason::{Divergence, KspDiverged, SnesDiverged, SolveFailure};
 use super::two_level;
 use super::vector::{PVec, VecRef};
+use super::yield_zone;
 use mpi::raw::AsRaw;
 use mpi::topology::SimpleCommunicator;
 use std::ffi::c_void;
@@ -32,6 +33,12 @@ pub trait NonlinearProblem {
     /// ([`LinearSolver::damps_jacobi_smoother`]) then needs no eigenvalue estimate.
     fn smoother_damping(&self) -> Option<f64> {
         None
+    }
+    /// The global displacement dofs of the triangles whose tangent has yielded at the last
+    /// Jacobian (this rank's triangles; repeats allowed), for the field split's yield zone
+    /// ([`super::yield_zone`]). Asked once after every Jacobian where the zone is in use.
+    fn yielded_dofs(&mut self) -> Vec<usize> {
+        Vec::new()
     }
 }
 
@@ -64,6 +71,19 @@ struct Ctx<'a> {
     damped_smoother: bool,
     /// Set up the p-multigrid's coarse solver at the next Jacobian (the first of the solve).
     coarse_first: bool,
+}
+
+/// Collective. Hands the problem's yielded dofs to the field split's yield zone, if it has one.
+fn update_yield_zone(snes: ffi::SNES, x: VecRef<'_>, ctx: &mut Ctx) -> Result<(), PetscError> {
+    // SAFETY: the SNES is live during its callback; its PCs are borrowed from it.
+    unsafe {
+        let pc = preconditioner(snes)?;
+        if let Some(block) = yield_zone::find(pc)? {
+            let dofs = ctx.problem.yielded_dofs();
+            yield_zone::set_zone(block, x, &dofs)?;
+        }
+    }
+    Ok(())
 }
 
 const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
@@ -288,7 +308,11 @@ impl Snes {
         // SAFETY: live SNES we own; its PC is borrowed from it; the matrices and vectors it
         // referenced stay owned by us. The two-level cycle has no reset of its own.
         unsafe {
-            two_level::reset(preconditioner(self.raw)?)?;
+            let pc = preconditioner(self.raw)?;
+            two_level::reset(pc)?;
+            if let Some(block) = yield_zone::find(pc)? {
+                yield_zone::reset(block)?;
+            }
             check(ffi::SNESReset(self.raw), "SNESReset")
         }
     }
@@ -382,6 +406,14 @@ unsafe extern "C" fn jacobian_cb(
             }),
         };
         if let Err(e) = damped {
+            ctx_note(ctx, Some(()), &e.to_string());
+            return PETSC_ERR_USER;
+        }
+    }
+    {
+        // SAFETY: PETSc keeps x alive during the callback.
+        let x = unsafe { VecRef::lent(x) };
+        if let Err(e) = update_yield_zone(snes, x, ctx) {
             ctx_note(ctx, Some(()), &e.to_string());
             return PETSC_ERR_USER;
         }

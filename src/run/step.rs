@@ -320,10 +320,12 @@ impl Simulation {
         let iterative = match solver.linear {
             LinearChoice::Direct => false,
             LinearChoice::Iterative => true,
-            // The field split is left to an explicit choice: at yield its displacement block
-            // loses the stiffness AMG needs (measured on block-compression, uniformly plastic
-            // at step 1: GMRES did not converge in 1000 iterations with GAMG on that block).
-            // Nor does any AMG or p-multigrid hold a yielded P2 tangent: block-compression with
+            // The field split is left to an explicit choice: at yield it solves the yielded
+            // zone of its displacement block exactly (GAMG alone does not converge there), so
+            // it costs a direct solve of the zone on top of the iterations, and it was 2.7–3.1
+            // times slower than the direct path on footing-shallow at 1.8 k–28 k particles
+            // (bench/VALIDATION.md, "The field split at yield, solved"). Nor does any AMG or
+            // p-multigrid hold a yielded P2 tangent: block-compression with
             // `solver.element = "p2"` (h = 0.05, 2 ranks) stopped at step 2 with GMRES at its
             // iteration limit with either, even with an exact coarse solve.
             LinearChoice::Auto => {
@@ -516,6 +518,11 @@ impl Simulation {
             problem = problem.with_schur_preconditioner(SchurPreconditioner {
                 matrix: &split.pressure_mass,
                 pressure_index: &split.layout.pressure_index,
+                shear_modulus: {
+                    let m = &self.model.scene.material;
+                    m.young / (2.0 * (1.0 + m.poisson))
+                },
+                yielded: Default::default(),
             });
         } else if *amg {
             // The modes at this increment's start: the nodes moved since the matrix was made.

@@ -121,7 +121,17 @@ pub struct StepProblem<'a> {
 pub struct SchurPreconditioner<'a> {
     pub matrix: &'a Mat,
     pub pressure_index: &'a [usize],
+    /// The elastic shear modulus: a triangle whose tangent's shear stiffness
+    /// ([`super::split::effective_shear_modulus`]) is below [`YIELDED_SHEAR`] of it has yielded.
+    pub shear_modulus: f64,
+    /// The global displacement dofs of the triangles that yielded at the last Jacobian.
+    pub yielded: RefCell<Vec<usize>>,
 }
+
+/// The fraction of the elastic shear stiffness below which a triangle counts as yielded: one
+/// yielded Gauss point of three leaves at most (2 + 1/2)/3 = 0.83 of it, an elastic triangle
+/// all of it.
+const YIELDED_SHEAR: f64 = 0.9;
 
 /// The coarse level of the p-multigrid: its matrix, assembled with every Jacobian as the
 /// Galerkin product of the tangent ([`CoarseSpace::galerkin_element`]).
@@ -763,6 +773,13 @@ impl NonlinearProblem for StepProblem<'_> {
         Ok(())
     }
 
+    fn yielded_dofs(&mut self) -> Vec<usize> {
+        self.schur
+            .as_ref()
+            .map(|s| std::mem::take(&mut *s.yielded.borrow_mut()))
+            .unwrap_or_default()
+    }
+
     fn smoother_damping(&self) -> Option<f64> {
         self.jacobi_bound
             .get()
@@ -950,11 +967,15 @@ impl StepProblem<'_> {
         };
         let m = schur.matrix.as_ref();
         m.zero_entries()?;
+        let mut yielded = schur.yielded.borrow_mut();
+        yielded.clear();
         for (t, nodes) in self.dofs.tri_nodes.iter().enumerate() {
             let owned: Vec<usize> = (0..3)
                 .filter(|&a| self.dofs.node_owned[nodes[a] as usize])
                 .collect();
-            if owned.is_empty() {
+            // Each triangle once over the ranks: its owner marks it.
+            let marks = self.mesh.tri_owned[t];
+            if owned.is_empty() && !marks {
                 continue;
             }
             let du: [[f64; 2]; 6] = std::array::from_fn(|k| self.node_u(local, nodes[k] as usize));
@@ -966,6 +987,15 @@ impl StepProblem<'_> {
                 self.setup.material,
             )
             .unwrap_or(f64::INFINITY);
+            if marks && g < YIELDED_SHEAR * schur.shear_modulus {
+                for &n in nodes {
+                    let first = self.dofs.node_global[n as usize];
+                    yielded.extend([first, first + 1]);
+                }
+            }
+            if owned.is_empty() {
+                continue;
+            }
             let area = crate::fem::p1::area(&[x[0], x[1], x[2]]);
             let factor = -scale * scale * (1.0 / g.max(f64::MIN_POSITIVE) + 1.0 / bulk);
             let mass = super::split::p1_mass(area);
