@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Run time against error with `[mesh.adapt]` (issue 10, item 5, last sentence) for SCENE
-# (`footing`, `tbar-smooth` or `pipeline`): one run of the scene's short push
+# (`footing`, `tbar-smooth`, `tbar-rough` or `pipeline`): one run of the scene's short push
 # (bench/error_vs_time.py `push`: the footing's 2 m, z/B = 1; the T-bar's 0.25D; the pipeline's
 # vertical stage alone, w = 0.5D) with the spacing factor FACTOR applied to
 # `mesh.h` and the `mesh.fine` regions (bench/error_vs_time.py `mesh`), STEPS steps, RANKS ranks,
@@ -9,7 +9,7 @@
 # rank, CPU s summed over the ranks) and judged by bench/error_vs_time.py `measure`:
 #   footing      the q/cu curve against the h/2 curve at z/B = 0.25-1, and the worst step from
 #                z/B = 0.25 on
-#   tbar-smooth  |mean Nc / 9.142 - 1| over the steps with w >= 0.1D
+#   tbar-smooth  |mean Nc / 9.142 - 1| over the steps with w >= 0.1D (tbar-rough: 11.940)
 #   pipeline     |V/(D cu) / V_ref - 1| at w = 0.5D, V_ref the reference of
 #                bench/results/pipeline.csv (as in pipeline.md: 4.4301, the finest spacing's value)
 # Appends a row to bench/results/SCENE-adapt.csv and the invocation to
@@ -28,12 +28,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
-scene=${1:?usage: bench/adapt_study.sh footing|tbar-smooth|pipeline}
+scene=${1:?usage: bench/adapt_study.sh footing|tbar-smooth|tbar-rough|pipeline}
 case $scene in
   footing) default_steps=100 default_timeout=3000 ;;
-  tbar-smooth) default_steps=10 default_timeout=900 ;;
+  tbar-smooth | tbar-rough) default_steps=10 default_timeout=900 ;;
   pipeline) default_steps=50 default_timeout=900 ;;
-  *) echo "adapt_study.sh: unknown scene $scene (footing, tbar-smooth or pipeline)" >&2 && exit 2 ;;
+  *) echo "adapt_study.sh: unknown scene $scene (footing, tbar-smooth, tbar-rough or pipeline)" >&2 && exit 2 ;;
 esac
 helper=$root/bench/error_vs_time.py
 factor=${FACTOR:-1}
