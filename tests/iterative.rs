@@ -374,6 +374,45 @@ fn the_field_split_holds_a_yielded_block_through_its_exact_zone() {
     );
 }
 
+#[test]
+fn a_yielded_p2_mesh_converges_through_the_yield_zone() {
+    let dir = workdir("iterative-yield-zone-p2");
+    // The P2 block yields everywhere from step 2 on; GAMG alone stopped there.
+    for ranks in [1, 2] {
+        let (diff, (newton, linear)) = direct_against_iterative(
+            &dir,
+            "block-compression",
+            &["solver.element=\"p2\""],
+            ranks,
+            4,
+            &[],
+        );
+        println!("block-compression (P2), {ranks} ranks: max relative difference {diff:.2e}, {newton} Newton and {linear} linear iterations");
+        assert!(diff < 1e-6, "{ranks} ranks: {diff:e}");
+        assert!(linear > newton, "{ranks} ranks: the iterative path ran");
+    }
+    let out = common::run(
+        &dir,
+        1,
+        &[
+            "iterative.h5",
+            "--out",
+            "gamg",
+            "--until-step",
+            "2",
+            "--",
+            "-pfem_yield_zone",
+            "false",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("step 2") && stderr.contains("DIVERGED_ITS"),
+        "{stderr}"
+    );
+}
+
 /// A P2 mesh of a distorted 3 x 2 patch of squares cut into triangles: node coordinates
 /// (vertices, then midside nodes) and the 6 nodes of every triangle.
 fn patch() -> (Vec<[f64; 2]>, Vec<[usize; 6]>) {

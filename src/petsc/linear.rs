@@ -33,7 +33,16 @@ pub enum LinearSolver<'a> {
     /// cantilever at h = 1/128 (165 k particles, 2 ranks, one step): peak RSS 1490 MB per rank
     /// with GMRES, 1255 MB with CG, 182 Krylov iterations against 173, the tracked
     /// displacements equal to 1e-15.
-    Amg { rtol: Scalar, symmetric: bool },
+    ///
+    /// With `yield_zone` (a plastic tangent) GAMG is followed by an exact solve on the rows of
+    /// the yielded triangles ([`super::yield_zone`]), unless the command line says otherwise
+    /// (`-pfem_yield_zone false`, `-pc_type`); the Krylov method is then GMRES (the pair is not
+    /// a symmetric preconditioner).
+    Amg {
+        rtol: Scalar,
+        symmetric: bool,
+        yield_zone: bool,
+    },
     /// As [`LinearSolver::Amg`], preconditioned by a two-level p-multigrid instead of GAMG on
     /// the P2 system: one Jacobi sweep before and after on P2 (Richardson damped by the
     /// Jacobian's spectral bound where the tangent is symmetric,
@@ -185,7 +194,7 @@ impl LinearSolver<'_> {
     /// afresh at the start of every Newton solve). GAMG's set-up is a third of an iterative
     /// solve on the cantilever, and the tangent of one Newton iteration preconditions the next
     /// well: measured at h = 1/16 (2 steps), lag 2 took 680 Krylov iterations instead of 651
-    /// and 3.3-4.6 s of CPU instead of 5.3-6.1 s. The direct and field-split paths rebuild
+    /// and 3.3-4.6 s of CPU instead of 5.3-6.1 s (elastic). The direct and field-split paths rebuild
     /// every iteration (a lagged LU is a different Newton method; a lagged split misses the
     /// plastic tangent's changes). The p-multigrid rebuilds every iteration: its levels set
     /// themselves up again on first use whenever their operators change (the fine smoother's
@@ -194,6 +203,12 @@ impl LinearSolver<'_> {
     /// 15, 20, 27, 32, 31, 31, 31 CG iterations with lag 1, 2 and 3).
     pub fn preconditioner_lag(&self) -> usize {
         match self {
+            // The yield zone follows the plastic tangent: a stale one cut the P2 block's first
+            // step (block-compression, `solver.element = "p2"`: 13 Newton iterations and a cut
+            // with lag 2, the direct path's 11 with lag 1).
+            LinearSolver::Amg {
+                yield_zone: true, ..
+            } => 1,
             LinearSolver::Amg { .. } => 2,
             LinearSolver::PMultigrid { .. }
             | LinearSolver::Direct { .. }
@@ -334,11 +349,21 @@ impl LinearSolver<'_> {
                         "PCFactorSetMatSolverType",
                     )?;
                 }
-                LinearSolver::Amg { rtol, symmetric } => {
-                    if *symmetric {
+                LinearSolver::Amg {
+                    rtol,
+                    symmetric,
+                    yield_zone,
+                } => {
+                    let zone = *yield_zone
+                        && bool_option("-pfem_yield_zone", true)?
+                        && option_string("-pc_type")?.is_none();
+                    if *symmetric && !zone {
                         conjugate_gradients(ksp, *rtol)?;
                     } else {
                         krylov(ksp, *rtol)?;
+                    }
+                    if zone {
+                        return super::yield_zone::install(pc, std::ptr::null_mut(), pc, "");
                     }
                     set_pc_type(pc, "gamg")?;
                     // native-stack.md pitfall 4: reused GAMG interpolation once gave an
@@ -532,7 +557,7 @@ unsafe fn install_yield_zone(pc: ffi::PC, displacement: &IndexSet) -> Result<(),
         };
         let mut block_pc: ffi::PC = std::ptr::null_mut();
         check(ffi::KSPGetPC(ksp, &mut block_pc), "KSPGetPC(u)")?;
-        super::yield_zone::install(block_pc, displacement.raw, pc)
+        super::yield_zone::install(block_pc, displacement.raw, pc, "fieldsplit_u_")
     }
 }
 

@@ -41,6 +41,37 @@ unsafe fn has_type(object: ffi::PetscObject, name: &str) -> Result<bool, PetscEr
     Ok(same == ffi::PetscBool_PETSC_TRUE)
 }
 
+/// The context of `pc` if it is a PCSHELL named `name` (our shells tell themselves apart by
+/// name: a context of one read as another's would be undefined behaviour).
+///
+/// # Safety
+/// `pc` must be a live PC.
+unsafe fn shell_context(
+    pc: ffi::PC,
+    name: &str,
+) -> Result<Option<*mut std::ffi::c_void>, PetscError> {
+    // SAFETY: as the caller promises; the name PETSc returns lives as long as the PC.
+    unsafe {
+        if !has_type(pc as ffi::PetscObject, "shell")? {
+            return Ok(None);
+        }
+        let mut given: *const std::os::raw::c_char = std::ptr::null();
+        error::check(ffi::PCShellGetName(pc, &mut given), "PCShellGetName")?;
+        if given.is_null() || std::ffi::CStr::from_ptr(given).to_bytes() != name.as_bytes() {
+            return Ok(None);
+        }
+        let mut raw: *mut std::ffi::c_void = std::ptr::null_mut();
+        error::check(
+            ffi::PCShellGetContext(
+                pc,
+                &mut raw as *mut *mut std::ffi::c_void as *mut std::ffi::c_void,
+            ),
+            "PCShellGetContext",
+        )?;
+        Ok((!raw.is_null()).then_some(raw))
+    }
+}
+
 pub use error::PetscError;
 pub use index_set::IndexSet;
 pub use init::Petsc;

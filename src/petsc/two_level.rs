@@ -12,6 +12,8 @@ use super::vector::VecRef;
 use std::ffi::c_void;
 
 const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
+/// The shell's name, which tells the cycle from our other shells.
+const NAME: &str = "p-multigrid (P2 Richardson-Jacobi, P1 coarse solver)";
 
 /// What the shell keeps. Every handle is its own reference, released on destroy.
 struct TwoLevel {
@@ -50,7 +52,7 @@ pub(super) unsafe fn set(
     coarse: ffi::KSP,
 ) -> Result<(), PetscError> {
     let kind = super::init::cstring("shell")?;
-    let name = super::init::cstring("p-multigrid (P2 Richardson-Jacobi, P1 coarse solver)")?;
+    let name = super::init::cstring(NAME)?;
     // SAFETY: the caller's objects are live; the context is a leaked Box that the destroy
     // callback reclaims exactly once; until it is registered, a failure reclaims it here
     // (releasing the interpolation's reference and the coarse solver).
@@ -96,19 +98,9 @@ pub(super) unsafe fn set(
 /// # Safety
 /// `pc` must be live; the borrow must end before the preconditioner is destroyed.
 unsafe fn context<'a>(pc: ffi::PC) -> Result<Option<&'a mut TwoLevel>, PetscError> {
-    // SAFETY: live PC; a shell's context is only ever set by `set` (no shell is made from
-    // the command line), so it is a live `TwoLevel`.
-    unsafe {
-        if !super::has_type(pc as ffi::PetscObject, "shell")? {
-            return Ok(None);
-        }
-        let mut raw: *mut c_void = std::ptr::null_mut();
-        check(
-            ffi::PCShellGetContext(pc, &mut raw as *mut *mut c_void as *mut c_void),
-            "PCShellGetContext",
-        )?;
-        Ok((raw as *mut TwoLevel).as_mut())
-    }
+    // SAFETY: live PC; a shell named NAME is only ever made by `set`.
+    Ok(unsafe { super::shell_context(pc, NAME) }?
+        .map(|raw| unsafe { &mut *(raw as *mut TwoLevel) }))
 }
 
 /// Whether `pc` is the two-level cycle.

@@ -1,11 +1,12 @@
-//! The field split's displacement block at yield (PCSHELL): GAMG on the whole block, then an
-//! exact solve on the rows of the yielded zone. A perfectly plastic tangent has no stiffness
-//! along the flow direction at every yielded Gauss point, so the block's near-kernel is as
-//! large as the yielded zone and spans it (a mechanism); no smoother or aggregation sees it,
-//! and splitting the zone into blocks cuts the mechanism (both measured: bench/VALIDATION.md,
-//! "The field split at yield"). The zone's own factorisation captures it whole, and GAMG
-//! keeps the elastic rest. Where the soil is elastic the zone is empty and this is GAMG; where
-//! it is at yield everywhere it costs a direct solve of the block.
+//! A displacement system at yield (PCSHELL): GAMG on the whole block (the field split's
+//! displacement block, or a P2 system), then an exact solve on the rows of the yielded zone.
+//! A perfectly plastic tangent has no stiffness along the flow direction at every yielded
+//! Gauss point, so the block's near-kernel is as large as the yielded zone and spans it (a
+//! mechanism); no smoother or aggregation sees it, and splitting the zone into blocks cuts the
+//! mechanism (both measured: bench/VALIDATION.md, "The field split at yield"). The zone's own
+//! factorisation captures it whole, and GAMG keeps the elastic rest. Where the soil is elastic
+//! the zone is empty and this is GAMG; where it is at yield everywhere it costs a direct solve
+//! of the block.
 
 use super::error::{check, PetscError};
 use super::ffi;
@@ -23,11 +24,12 @@ const KEY: &str = "pfem_yield_zone";
 
 /// What the shell keeps. Every handle is its own reference, released on destroy.
 struct YieldZone {
-    /// GAMG on the whole block (options prefix `fieldsplit_u_`).
+    /// GAMG on the whole block (options prefix `fieldsplit_u_`, or none on a P2 system).
     amg: ffi::PC,
-    /// The zone's exact solver (options prefix `fieldsplit_u_zone_`): MUMPS LU.
+    /// The zone's exact solver (options prefix GAMG's and `zone_`): MUMPS LU.
     exact: ffi::KSP,
-    /// The displacement field in the whole system's numbering (to find the block's rows).
+    /// The displacement field in the whole system's numbering (to find the block's rows);
+    /// null when the block is the whole system.
     field: ffi::IS,
     /// This rank's yielded rows of the block (the block's numbering), for the next set-up.
     rows: Vec<Int>,
@@ -60,15 +62,17 @@ impl YieldZone {
     }
 }
 
-/// Collective. Makes `pc` (the displacement block's, `field` its rows in the whole system)
-/// the yield-zone preconditioner, and lets `outer` (the field split) find it.
+/// Collective. Makes `pc` (the displacement block's, `field` its rows in the whole system;
+/// null: `pc` is the whole system's) the yield-zone preconditioner, its GAMG reading options
+/// under `prefix`, and lets `outer` (the field split, or `pc` itself) find it.
 ///
 /// # Safety
-/// `pc`, `field` and `outer` must be live PETSc objects.
+/// `pc` and `outer` must be live PETSc objects, `field` live or null.
 pub(super) unsafe fn install(
     pc: ffi::PC,
     field: ffi::IS,
     outer: ffi::PC,
+    prefix: &str,
 ) -> Result<(), PetscError> {
     let kind = cstring("shell")?;
     let name = cstring(NAME)?;
@@ -95,10 +99,12 @@ pub(super) unsafe fn install(
             block_size: 0,
             configured: false,
         };
-        check(
-            ffi::PetscObjectReference(field as ffi::PetscObject),
-            "PetscObjectReference(field)",
-        )?;
+        if !field.is_null() {
+            check(
+                ffi::PetscObjectReference(field as ffi::PetscObject),
+                "PetscObjectReference(field)",
+            )?;
+        }
         let made = check(ffi::PCCreate(comm, &mut zone.amg), "PCCreate(amg)")
             .and_then(|()| check(ffi::KSPCreate(comm, &mut zone.exact), "KSPCreate(zone)"));
         if let Err(e) = made {
@@ -122,16 +128,19 @@ pub(super) unsafe fn install(
         check(ffi::PCShellSetSetUp(pc, Some(setup_cb)), "PCShellSetSetUp")?;
         check(ffi::PCShellSetApply(pc, Some(apply_cb)), "PCShellSetApply")?;
         check(ffi::PCShellSetView(pc, Some(view_cb)), "PCShellSetView")?;
-        check(
-            ffi::PetscObjectCompose(
-                outer as ffi::PetscObject,
-                key.as_ptr(),
-                pc as ffi::PetscObject,
-            ),
-            "PetscObjectCompose(yield zone)",
-        )?;
+        if outer != pc {
+            check(
+                ffi::PetscObjectCompose(
+                    outer as ffi::PetscObject,
+                    key.as_ptr(),
+                    pc as ffi::PetscObject,
+                ),
+                "PetscObjectCompose(yield zone)",
+            )?;
+        }
         let z = &mut *(raw as *mut YieldZone);
-        let prefix = cstring("fieldsplit_u_")?;
+        let zone_prefix = cstring(&format!("{prefix}zone_"))?;
+        let prefix = cstring(prefix)?;
         check(
             ffi::PCSetOptionsPrefix(z.amg, prefix.as_ptr()),
             "PCSetOptionsPrefix(amg)",
@@ -143,9 +152,8 @@ pub(super) unsafe fn install(
             ffi::PCGAMGSetReuseInterpolation(z.amg, ffi::PetscBool_PETSC_FALSE),
             "PCGAMGSetReuseInterpolation",
         )?;
-        let prefix = cstring("fieldsplit_u_zone_")?;
         check(
-            ffi::KSPSetOptionsPrefix(z.exact, prefix.as_ptr()),
+            ffi::KSPSetOptionsPrefix(z.exact, zone_prefix.as_ptr()),
             "KSPSetOptionsPrefix(zone)",
         )?;
         let preonly = cstring("preonly")?;
@@ -174,6 +182,9 @@ pub(super) unsafe fn find(outer: ffi::PC) -> Result<Option<ffi::PC>, PetscError>
     let mut found: ffi::PetscObject = std::ptr::null_mut();
     // SAFETY: as the caller promises.
     unsafe {
+        if context(outer)?.is_some() {
+            return Ok(Some(outer));
+        }
         // A command-line `-pc_type` replaces the split; the block's PC then lingers unused.
         if !super::has_type(outer as ffi::PetscObject, "fieldsplit")? {
             return Ok(None);
@@ -196,22 +207,8 @@ pub(super) unsafe fn find(outer: ffi::PC) -> Result<Option<ffi::PC>, PetscError>
 /// `pc` must be live; the borrow must end before the preconditioner is destroyed.
 unsafe fn context<'a>(pc: ffi::PC) -> Result<Option<&'a mut YieldZone>, PetscError> {
     // SAFETY: live PC; a shell named NAME is only ever made by `install`.
-    unsafe {
-        if !super::has_type(pc as ffi::PetscObject, "shell")? {
-            return Ok(None);
-        }
-        let mut name: *const std::os::raw::c_char = std::ptr::null();
-        check(ffi::PCShellGetName(pc, &mut name), "PCShellGetName")?;
-        if name.is_null() || std::ffi::CStr::from_ptr(name).to_bytes() != NAME.as_bytes() {
-            return Ok(None);
-        }
-        let mut raw: *mut c_void = std::ptr::null_mut();
-        check(
-            ffi::PCShellGetContext(pc, &mut raw as *mut *mut c_void as *mut c_void),
-            "PCShellGetContext",
-        )?;
-        Ok((raw as *mut YieldZone).as_mut())
-    }
+    Ok(unsafe { super::shell_context(pc, NAME) }?
+        .map(|raw| unsafe { &mut *(raw as *mut YieldZone) }))
 }
 
 /// Collective. The next set-up's zone: the block rows of `dofs` (global dofs of the whole
@@ -248,11 +245,13 @@ pub(super) unsafe fn set_zone(
         )?;
         check(ffi::VecAssemblyBegin(marker.raw), "VecAssemblyBegin")?;
         check(ffi::VecAssemblyEnd(marker.raw), "VecAssemblyEnd")?;
-        let mut sub: ffi::Vec = std::ptr::null_mut();
-        check(
-            ffi::VecGetSubVector(marker.raw, z.field, &mut sub),
-            "VecGetSubVector(field)",
-        )?;
+        let mut sub: ffi::Vec = marker.raw;
+        if !z.field.is_null() {
+            check(
+                ffi::VecGetSubVector(marker.raw, z.field, &mut sub),
+                "VecGetSubVector(field)",
+            )?;
+        }
         let mut first: Int = 0;
         let mut end: Int = 0;
         let read = check(
@@ -268,10 +267,12 @@ pub(super) unsafe fn set_zone(
                     .collect::<Vec<Int>>()
             })
         });
-        check(
-            ffi::VecRestoreSubVector(marker.raw, z.field, &mut sub),
-            "VecRestoreSubVector(field)",
-        )?;
+        if !z.field.is_null() {
+            check(
+                ffi::VecRestoreSubVector(marker.raw, z.field, &mut sub),
+                "VecRestoreSubVector(field)",
+            )?;
+        }
         z.rows = read?;
         Ok(())
     }

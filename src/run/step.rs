@@ -320,14 +320,12 @@ impl Simulation {
         let iterative = match solver.linear {
             LinearChoice::Direct => false,
             LinearChoice::Iterative => true,
-            // The field split is left to an explicit choice: at yield it solves the yielded
-            // zone of its displacement block exactly (GAMG alone does not converge there), so
-            // it costs a direct solve of the zone on top of the iterations, and it was 2.7–3.1
-            // times slower than the direct path on footing-shallow at 1.8 k–28 k particles
-            // (bench/VALIDATION.md, "The field split at yield, solved"). Nor does any AMG or
-            // p-multigrid hold a yielded P2 tangent: block-compression with
-            // `solver.element = "p2"` (h = 0.05, 2 ranks) stopped at step 2 with GMRES at its
-            // iteration limit with either, even with an exact coarse solve.
+            // Plastic scenes are left to an explicit choice: at yield the iterative paths solve
+            // the yielded zone exactly (GAMG alone does not converge there, on the field
+            // split's displacement block or on a P2 system), so they cost a direct solve of
+            // the zone on top of the iterations: 2.6–3.1 times the direct path's time on
+            // footing-shallow at 1.8 k–28 k particles (bench/VALIDATION.md, "The field split
+            // at yield, solved").
             LinearChoice::Auto => {
                 auto_is_iterative(dofs.vertex_dofs, self.model.plastic(), dofs.n_global_dofs)
             }
@@ -340,32 +338,35 @@ impl Simulation {
         if iterative && world.size() > 1 && dofs.n_global_dofs > LEAN_PRODUCTS_ABOVE_DOFS {
             crate::petsc::linear::prefer_lean_galerkin_products()?;
         }
-        let pmg = if iterative && split.is_none() && p_multigrid_from_options()? {
-            let space = CoarseSpace::build(world, mesh, dofs).map_err(|e| PetscError {
-                code: -1,
-                message: e.to_string(),
-            })?;
-            let interpolation = {
-                let map = InterpolationMap::new(dofs, constraints, &space);
-                let op = Interpolation::new(world, map)?;
-                Mat::shell(world, [dofs.n_owned_dofs, space.n_owned], Box::new(op))?
+        // A yielded P2 tangent needs the yield zone ([`LinearSolver::Amg`]), which wraps GAMG.
+        let pmg =
+            if iterative && split.is_none() && !self.model.plastic() && p_multigrid_from_options()?
+            {
+                let space = CoarseSpace::build(world, mesh, dofs).map_err(|e| PetscError {
+                    code: -1,
+                    message: e.to_string(),
+                })?;
+                let interpolation = {
+                    let map = InterpolationMap::new(dofs, constraints, &space);
+                    let op = Interpolation::new(world, map)?;
+                    Mat::shell(world, [dofs.n_owned_dofs, space.n_owned], Box::new(op))?
+                };
+                let coarse = {
+                    let (d_nnz, o_nnz) = CoarseSpace::operator_preallocation(dofs);
+                    Mat::aij(world, space.n_owned, 2, &d_nnz, &o_nnz)?
+                };
+                // The coarse nodes' rigid-body modes at the increment's start, for GAMG (the
+                // matrix holds its own reference to the space).
+                let modes = orthonormal_rigid_body_modes(world, &space.coordinates(mesh, dofs));
+                coarse.set_near_null_space(&NullSpace::new(world, space.n_owned, &modes)?)?;
+                Some(PMultigrid {
+                    space,
+                    interpolation,
+                    coarse,
+                })
+            } else {
+                None
             };
-            let coarse = {
-                let (d_nnz, o_nnz) = CoarseSpace::operator_preallocation(dofs);
-                Mat::aij(world, space.n_owned, 2, &d_nnz, &o_nnz)?
-            };
-            // The coarse nodes' rigid-body modes at the increment's start, for GAMG (the
-            // matrix holds its own reference to the space).
-            let modes = orthonormal_rigid_body_modes(world, &space.coordinates(mesh, dofs));
-            coarse.set_near_null_space(&NullSpace::new(world, space.n_owned, &modes)?)?;
-            Some(PMultigrid {
-                space,
-                interpolation,
-                coarse,
-            })
-        } else {
-            None
-        };
         // The p-multigrid only multiplies by the P2 tangent and reads its diagonal: blocks,
         // and only the upper triangle of a symmetric one.
         let jac =
@@ -399,6 +400,7 @@ impl Simulation {
             None if iterative => LinearSolver::Amg {
                 rtol: AMG_RTOL,
                 symmetric: self.symmetric_tangent(),
+                yield_zone: self.model.plastic(),
             },
             None => LinearSolver::Direct {
                 reuse: crate::petsc::FactorReuse::from_options(solver.reuse_factorisation)?,
@@ -504,6 +506,9 @@ impl Simulation {
             StepProblem::new(world, mesh, dofs, setup, x).map_err(|e| err(e.to_string()))?;
         if iterative {
             problem = problem.without_element_cache();
+            if self.model.plastic() {
+                problem = problem.with_yielded_zone();
+            }
         }
         if let Some(m) = pmg {
             problem = problem.with_coarse_operator(CoarseOperator {
@@ -518,11 +523,6 @@ impl Simulation {
             problem = problem.with_schur_preconditioner(SchurPreconditioner {
                 matrix: &split.pressure_mass,
                 pressure_index: &split.layout.pressure_index,
-                shear_modulus: {
-                    let m = &self.model.scene.material;
-                    m.young / (2.0 * (1.0 + m.poisson))
-                },
-                yielded: Default::default(),
             });
         } else if *amg {
             // The modes at this increment's start: the nodes moved since the matrix was made.

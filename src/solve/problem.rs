@@ -114,6 +114,9 @@ pub struct StepProblem<'a> {
     /// assembles them one at a time (one more element pass per Newton iteration).
     cache: RefCell<Option<(Vec<f64>, Vec<ElementResult>)>>,
     keep_elements: bool,
+    /// Where the linear solver asks for the yielded zone: the global displacement dofs of the
+    /// owned triangles with a Gauss point that yields at the last Jacobian's iterate.
+    yielded: Option<RefCell<Vec<usize>>>,
 }
 
 /// The pressure mass matrix scaled by −1/G that a Schur-complement preconditioner uses, and
@@ -121,17 +124,7 @@ pub struct StepProblem<'a> {
 pub struct SchurPreconditioner<'a> {
     pub matrix: &'a Mat,
     pub pressure_index: &'a [usize],
-    /// The elastic shear modulus: a triangle whose tangent's shear stiffness
-    /// ([`super::split::effective_shear_modulus`]) is below [`YIELDED_SHEAR`] of it has yielded.
-    pub shear_modulus: f64,
-    /// The global displacement dofs of the triangles that yielded at the last Jacobian.
-    pub yielded: RefCell<Vec<usize>>,
 }
-
-/// The fraction of the elastic shear stiffness below which a triangle counts as yielded: one
-/// yielded Gauss point of three leaves at most (2 + 1/2)/3 = 0.83 of it, an elastic triangle
-/// all of it.
-const YIELDED_SHEAR: f64 = 0.9;
 
 /// The coarse level of the p-multigrid: its matrix, assembled with every Jacobian as the
 /// Galerkin product of the tangent ([`CoarseSpace::galerkin_element`]).
@@ -170,6 +163,7 @@ impl<'a> StepProblem<'a> {
             jacobi_bound: Cell::new(None),
             cache: RefCell::new(None),
             keep_elements: true,
+            yielded: None,
         })
     }
 
@@ -223,6 +217,14 @@ impl<'a> StepProblem<'a> {
     /// Assembles `schur` with every Jacobian (mixed kernels only).
     pub fn with_schur_preconditioner(mut self, schur: SchurPreconditioner<'a>) -> Self {
         self.schur = Some(schur);
+        self
+    }
+
+    /// Every Jacobian lists the displacement dofs of the owned triangles that yield at its
+    /// iterate ([`NonlinearProblem::yielded_dofs`]): a Gauss point whose equivalent plastic
+    /// strain grows there has the plastic tangent, with no stiffness along its flow direction.
+    pub fn with_yielded_zone(mut self) -> Self {
+        self.yielded = Some(RefCell::new(Vec::new()));
         self
     }
 
@@ -774,9 +776,9 @@ impl NonlinearProblem for StepProblem<'_> {
     }
 
     fn yielded_dofs(&mut self) -> Vec<usize> {
-        self.schur
+        self.yielded
             .as_ref()
-            .map(|s| std::mem::take(&mut *s.yielded.borrow_mut()))
+            .map(|y| std::mem::take(&mut *y.borrow_mut()))
             .unwrap_or_default()
     }
 
@@ -806,7 +808,23 @@ impl NonlinearProblem for StepProblem<'_> {
             !bounded || (self.setup.contact.is_empty() && self.setup.surface.is_empty()),
             "contact and follower pressures are neither element matrices nor symmetric"
         );
+        let mut yielded = self.yielded.as_ref().map(|y| y.borrow_mut());
+        if let Some(y) = yielded.as_mut() {
+            y.clear();
+        }
         let evaluated = self.evaluate(x, true, |t, e| {
+            if let Some(y) = yielded.as_mut() {
+                // Each triangle once over the ranks: its owner lists it.
+                let start = self.setup.states_n.get(t);
+                if self.mesh.tri_owned[t]
+                    && e.states.iter().zip(&start).any(|(a, b)| a.eps_q > b.eps_q)
+                {
+                    for &n in &self.dofs.tri_nodes[t] {
+                        let first = self.dofs.node_global[n as usize];
+                        y.extend([first, first + 1]);
+                    }
+                }
+            }
             if let Some(c) = &self.coarse {
                 let m = c.matrix.as_ref();
                 coarse_diagonal += c
@@ -967,15 +985,11 @@ impl StepProblem<'_> {
         };
         let m = schur.matrix.as_ref();
         m.zero_entries()?;
-        let mut yielded = schur.yielded.borrow_mut();
-        yielded.clear();
         for (t, nodes) in self.dofs.tri_nodes.iter().enumerate() {
             let owned: Vec<usize> = (0..3)
                 .filter(|&a| self.dofs.node_owned[nodes[a] as usize])
                 .collect();
-            // Each triangle once over the ranks: its owner marks it.
-            let marks = self.mesh.tri_owned[t];
-            if owned.is_empty() && !marks {
+            if owned.is_empty() {
                 continue;
             }
             let du: [[f64; 2]; 6] = std::array::from_fn(|k| self.node_u(local, nodes[k] as usize));
@@ -987,15 +1001,6 @@ impl StepProblem<'_> {
                 self.setup.material,
             )
             .unwrap_or(f64::INFINITY);
-            if marks && g < YIELDED_SHEAR * schur.shear_modulus {
-                for &n in nodes {
-                    let first = self.dofs.node_global[n as usize];
-                    yielded.extend([first, first + 1]);
-                }
-            }
-            if owned.is_empty() {
-                continue;
-            }
             let area = crate::fem::p1::area(&[x[0], x[1], x[2]]);
             let factor = -scale * scale * (1.0 / g.max(f64::MIN_POSITIVE) + 1.0 / bulk);
             let mass = super::split::p1_mass(area);
