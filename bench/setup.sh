@@ -20,3 +20,19 @@ else
 fi
 work=${BENCH_WORK:-target/bench}/$1
 rm -rf "$work" && mkdir -p "$work" && cd "$work"
+# The largest relative difference between two history.csv files (same columns), or "rows differ".
+compare_histories() {
+  python3 - "$1" "$2" <<'PY'
+import csv, sys
+a = list(csv.reader(open(sys.argv[1])))[1:]
+b = list(csv.reader(open(sys.argv[2])))[1:]
+worst = 0.0
+for ra, rb in zip(a, b):
+    for x, y in zip(ra, rb):
+        x, y = float(x), float(y)
+        s = max(abs(x), abs(y))
+        if s > 0:
+            worst = max(worst, abs(x - y) / s)
+print(f"{worst:.1e}" if len(a) == len(b) else "rows differ")
+PY
+}

@@ -14,21 +14,6 @@ shift $(( $# > 2 ? 2 : $# ))
 extra=("$@")
 until=${UNTIL:-5}
 source bench/setup.sh solver_scaling
-compare() {
-  python3 - "$1" "$2" <<'PY'
-import csv, sys
-a = list(csv.reader(open(sys.argv[1])))[1:]
-b = list(csv.reader(open(sys.argv[2])))[1:]
-worst = 0.0
-for ra, rb in zip(a, b):
-    for x, y in zip(ra, rb):
-        x, y = float(x), float(y)
-        s = max(abs(x), abs(y))
-        if s > 0:
-            worst = max(worst, abs(x - y) / s)
-print(f"{worst:.1e}" if len(a) == len(b) else "rows differ")
-PY
-}
 echo "| h | particles | ranks | path | wall (s) | CPU (s, all ranks) | Newton | linear | wall s per Newton it. | max RSS per rank (MB) | rel. diff. to direct |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for h in $spacings; do
@@ -50,7 +35,7 @@ for h in $spacings; do
         rss=$(grep -o 'rss_kb [0-9]*' "$out.log" | awk '{m = $2 > m ? $2 : m} END {printf "%.0f", m / 1024}')
         cpu=$(grep -o 'cpu_s [0-9.]*' "$out.log" | awk '{s += $2} END {printf "%.1f", s}')
         diff=-
-        [ "$path" = iterative ] && diff=$(compare "o_${h}_${ranks}_direct/history.csv" "$out/history.csv")
+        [ "$path" = iterative ] && diff=$(compare_histories "o_${h}_${ranks}_direct/history.csv" "$out/history.csv")
         printf '| %s | %s | %s | %s | %.1f | %s | %s | %s | %.3f | %s | %s |\n' "$h" "$particles" \
           "$ranks" "$path" "$wall" "$cpu" "$newton" "$linear" "$(echo "$wall / $newton" | bc -l)" \
           "$rss" "$diff"

@@ -17,21 +17,6 @@ ranks=${RANKS:-1}
 paths=${PATHS:-direct zone gamg}
 until=${UNTIL:-}
 source bench/setup.sh "yield_zone_$scene"
-compare() {
-  python3 - "$1" "$2" <<'PY'
-import csv, sys
-a = list(csv.reader(open(sys.argv[1])))[1:]
-b = list(csv.reader(open(sys.argv[2])))[1:]
-worst = 0.0
-for ra, rb in zip(a, b):
-    for x, y in zip(ra, rb):
-        x, y = float(x), float(y)
-        s = max(abs(x), abs(y))
-        if s > 0:
-            worst = max(worst, abs(x - y) / s)
-print(f"{worst:.1e}" if len(a) == len(b) else "rows differ")
-PY
-}
 echo "| h | particles | ranks | path | wall (s) | Newton | linear | linear per Newton | max RSS per rank (MB) | rel. diff. to direct |"
 echo "|---|---|---|---|---|---|---|---|---|---|"
 for h in $spacings; do
@@ -57,7 +42,7 @@ for h in $spacings; do
       rss=$(grep -o 'rss_kb [0-9]*' "$out.log" | awk '{m = $2 > m ? $2 : m} END {printf "%.0f", m / 1024}')
       diff=-
       [ "$path" != direct ] && [ -f "o_${h}_direct/history.csv" ] &&
-        diff=$(compare "o_${h}_direct/history.csv" "$out/history.csv")
+        diff=$(compare_histories "o_${h}_direct/history.csv" "$out/history.csv")
       printf '| %s | %s | %s | %s | %.1f | %s | %s | %.1f | %s | %s |\n' "$h" "$particles" "$ranks" \
         "$path" "$wall" "$newton" "$linear" "$(echo "$linear / $newton" | bc -l)" "$rss" "$diff"
     else

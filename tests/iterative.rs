@@ -300,6 +300,31 @@ fn nearly_incompressible_elastic_block_converges_with_the_field_split() {
     );
 }
 
+/// `iterative.h5` in `dir` (block-compression, yielded everywhere from step 2) with GAMG alone
+/// (`-pfem_yield_zone false`): the step is cut to failure.
+fn gamg_alone_stops_at_step_2(dir: &Path) {
+    let out = common::run(
+        dir,
+        1,
+        &[
+            "iterative.h5",
+            "--out",
+            "gamg",
+            "--until-step",
+            "2",
+            "--",
+            "-pfem_yield_zone",
+            "false",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("step 2") && stderr.contains("DIVERGED_ITS"),
+        "{stderr}"
+    );
+}
+
 #[test]
 fn the_field_split_holds_a_yielded_block_through_its_exact_zone() {
     let dir = workdir("iterative-yield-zone");
@@ -351,27 +376,8 @@ fn the_field_split_holds_a_yielded_block_through_its_exact_zone() {
         sizes.last().is_some_and(|&(zone, rows)| zone == rows),
         "step 2 yields everywhere: {sizes:?}"
     );
-    // Without it, GAMG alone does not converge at yield: the step is cut to failure.
-    let out = common::run(
-        &dir,
-        1,
-        &[
-            "iterative.h5",
-            "--out",
-            "gamg",
-            "--until-step",
-            "2",
-            "--",
-            "-pfem_yield_zone",
-            "false",
-        ],
-    );
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(
-        stderr.contains("step 2") && stderr.contains("DIVERGED_ITS"),
-        "{stderr}"
-    );
+    // Without it, GAMG alone does not converge at yield.
+    gamg_alone_stops_at_step_2(&dir);
 }
 
 #[test]
@@ -391,26 +397,7 @@ fn a_yielded_p2_mesh_converges_through_the_yield_zone() {
         assert!(diff < 1e-6, "{ranks} ranks: {diff:e}");
         assert!(linear > newton, "{ranks} ranks: the iterative path ran");
     }
-    let out = common::run(
-        &dir,
-        1,
-        &[
-            "iterative.h5",
-            "--out",
-            "gamg",
-            "--until-step",
-            "2",
-            "--",
-            "-pfem_yield_zone",
-            "false",
-        ],
-    );
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(
-        stderr.contains("step 2") && stderr.contains("DIVERGED_ITS"),
-        "{stderr}"
-    );
+    gamg_alone_stops_at_step_2(&dir);
 }
 
 /// A P2 mesh of a distorted 3 x 2 patch of squares cut into triangles: node coordinates

@@ -34,10 +34,9 @@ pub enum LinearSolver<'a> {
     /// with GMRES, 1255 MB with CG, 182 Krylov iterations against 173, the tracked
     /// displacements equal to 1e-15.
     ///
-    /// With `yield_zone` (a plastic tangent) GAMG is followed by an exact solve on the rows of
-    /// the yielded triangles ([`super::yield_zone`]), unless the command line says otherwise
-    /// (`-pfem_yield_zone false`, `-pc_type`); the Krylov method is then GMRES (the pair is not
-    /// a symmetric preconditioner).
+    /// With `yield_zone` (a plastic tangent; [`yield_zone_from_options`]) GAMG is followed by
+    /// an exact solve on the rows of the yielded triangles ([`super::yield_zone`]); the Krylov
+    /// method is then GMRES (the pair is not a symmetric preconditioner).
     Amg {
         rtol: Scalar,
         symmetric: bool,
@@ -66,6 +65,8 @@ pub enum LinearSolver<'a> {
     /// inverts it well enough).
     Schur {
         rtol: Scalar,
+        /// The displacement block's preconditioner is the yield zone (a plastic tangent).
+        yield_zone: bool,
         displacement: &'a IndexSet,
         pressure: &'a IndexSet,
         pressure_mass: &'a Mat,
@@ -354,9 +355,7 @@ impl LinearSolver<'_> {
                     symmetric,
                     yield_zone,
                 } => {
-                    let zone = *yield_zone
-                        && bool_option("-pfem_yield_zone", true)?
-                        && option_string("-pc_type")?.is_none();
+                    let zone = *yield_zone;
                     if *symmetric && !zone {
                         conjugate_gradients(ksp, *rtol)?;
                     } else {
@@ -454,6 +453,7 @@ impl LinearSolver<'_> {
                 }
                 LinearSolver::Schur {
                     rtol,
+                    yield_zone,
                     displacement,
                     pressure,
                     pressure_mass,
@@ -471,7 +471,7 @@ impl LinearSolver<'_> {
                     )?;
                     // The split's inner solvers exist from here, but the Schur type hands
                     // them out only once set up: the displacement block's is taken now.
-                    let zone = yield_zone_from_options()?;
+                    let zone = *yield_zone;
                     if zone {
                         install_yield_zone(pc, displacement)?;
                     }
@@ -494,8 +494,9 @@ impl LinearSolver<'_> {
                         ),
                         "PCFieldSplitSetSchurPre",
                     )?;
-                    // The split's inner solvers exist only once the PC is set up, so their
-                    // defaults go to the options database, where the command line wins.
+                    // The split's inner solvers read their options only when the PC is set
+                    // up, so their defaults go to the options database, where the command
+                    // line wins.
                     if !zone {
                         default_option("-fieldsplit_u_pc_type", "gamg")?;
                     }
@@ -514,11 +515,22 @@ impl LinearSolver<'_> {
     }
 }
 
-/// Whether the field split's displacement block is preconditioned by the yield zone
-/// ([`super::yield_zone`]): unless the PETSc option `-pfem_yield_zone false` (or `0`) is
-/// given or the command line names the block's own preconditioner (`-fieldsplit_u_pc_type`).
-fn yield_zone_from_options() -> Result<bool, PetscError> {
-    Ok(bool_option("-pfem_yield_zone", true)? && option_string("-fieldsplit_u_pc_type")?.is_none())
+/// Whether a plastic displacement system is preconditioned through the yield zone
+/// ([`super::yield_zone`]): the field split's displacement block (`split`) or a P2 system,
+/// unless the PETSc option `-pfem_yield_zone false` (or `0`) is given or the command line
+/// names that system's own preconditioner (`-fieldsplit_u_pc_type`, `-pc_type`). Its exact
+/// solve orders MUMPS as the direct path does, unless the command line says otherwise.
+pub fn yield_zone_from_options(split: bool) -> Result<bool, PetscError> {
+    let (own, prefix) = if split {
+        ("-fieldsplit_u_pc_type", "-fieldsplit_u_zone_")
+    } else {
+        ("-pc_type", "-zone_")
+    };
+    let on = bool_option("-pfem_yield_zone", true)? && option_string(own)?.is_none();
+    if on {
+        default_option(&format!("{prefix}mat_mumps_icntl_7"), "2")?;
+    }
+    Ok(on)
 }
 
 /// Collective. Makes the displacement block's preconditioner of the field split `pc` (before
@@ -529,6 +541,7 @@ fn yield_zone_from_options() -> Result<bool, PetscError> {
 unsafe fn install_yield_zone(pc: ffi::PC, displacement: &IndexSet) -> Result<(), PetscError> {
     let mut n: ffi::PetscInt = 0;
     let mut sub: *mut ffi::KSP = std::ptr::null_mut();
+    let (func, file) = (cstring("install_yield_zone")?, cstring(file!())?);
     // SAFETY: as the caller promises; PETSc allocates the array of borrowed KSPs, freed here.
     unsafe {
         check(
@@ -540,7 +553,6 @@ unsafe fn install_yield_zone(pc: ffi::PC, displacement: &IndexSet) -> Result<(),
         } else {
             None
         };
-        let (func, file) = (cstring("install_yield_zone")?, cstring(file!())?);
         let freed = ffi::PetscFreeA(
             1,
             line!() as std::os::raw::c_int,

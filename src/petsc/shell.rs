@@ -166,3 +166,59 @@ unsafe extern "C" fn destroy_cb(ctx: *mut c_void) -> ffi::PetscErrorCode {
         PETSC_ERR_USER
     }
 }
+
+/// Prints `lines` to `viewer`, then runs `nested` (the inner solvers' views) one tab in: a
+/// shell preconditioner's view. Only a text viewer takes lines; any other gets nothing.
+///
+/// # Safety
+/// `viewer` must be live.
+pub(super) unsafe fn view_nested(
+    viewer: ffi::PetscViewer,
+    lines: &[String],
+    nested: impl FnOnce() -> Result<(), PetscError>,
+) -> Result<(), PetscError> {
+    // SAFETY: as the caller promises; the strings outlive the calls.
+    unsafe {
+        if !super::has_type(viewer as ffi::PetscObject, "ascii")? {
+            return Ok(());
+        }
+        let format = super::init::cstring("%s\n")?;
+        for line in lines {
+            let line = super::init::cstring(line)?;
+            check(
+                ffi::PetscViewerASCIIPrintf(viewer, format.as_ptr(), line.as_ptr()),
+                "PetscViewerASCIIPrintf",
+            )?;
+        }
+        check(
+            ffi::PetscViewerASCIIPushTab(viewer),
+            "PetscViewerASCIIPushTab",
+        )?;
+        let viewed = nested();
+        check(
+            ffi::PetscViewerASCIIPopTab(viewer),
+            "PetscViewerASCIIPopTab",
+        )?;
+        viewed
+    }
+}
+
+/// A shell preconditioner's destroy callback: reclaims its context, a `Box<T>` leaked when the
+/// shell was made, and hands it to `release`.
+///
+/// # Safety
+/// `pc`'s context must be null or a leaked `Box<T>`; PETSc calls destroy once.
+pub(super) unsafe fn reclaim<T>(pc: ffi::PC, release: unsafe fn(T)) -> ffi::PetscErrorCode {
+    let mut raw: *mut c_void = std::ptr::null_mut();
+    // SAFETY: as the caller promises.
+    unsafe {
+        let code = ffi::PCShellGetContext(pc, &mut raw as *mut *mut c_void as *mut c_void);
+        if code != 0 {
+            return code;
+        }
+        if !raw.is_null() {
+            release(*Box::from_raw(raw as *mut T));
+        }
+    }
+    0
+}

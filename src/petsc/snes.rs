@@ -35,7 +35,7 @@ pub trait NonlinearProblem {
         None
     }
     /// The global displacement dofs of the triangles whose tangent has yielded at the last
-    /// Jacobian (this rank's triangles; repeats allowed), for the field split's yield zone
+    /// Jacobian (this rank's triangles; repeats allowed), for the linear solver's yield zone
     /// ([`super::yield_zone`]). Asked once after every Jacobian where the zone is in use.
     fn yielded_dofs(&mut self) -> Vec<usize> {
         Vec::new()
@@ -73,7 +73,8 @@ struct Ctx<'a> {
     coarse_first: bool,
 }
 
-/// Collective. Hands the problem's yielded dofs to the field split's yield zone, if it has one.
+/// Collective. Hands the problem's yielded dofs to the yield zone (the field split's or the
+/// whole system's), if the linear solver has one.
 fn update_yield_zone(snes: ffi::SNES, x: VecRef<'_>, ctx: &mut Ctx) -> Result<(), PetscError> {
     // SAFETY: the SNES is live during its callback; its PCs are borrowed from it.
     unsafe {
@@ -303,7 +304,8 @@ impl Snes {
     /// hierarchy and the Krylov method's vectors), keeping the configuration; the next solve
     /// sets up again. The end of an increment's solver: the p-multigrid's coarse operator lost
     /// its rigid-body modes after GAMG's first aggregation, so a solve after a reset would
-    /// aggregate without them (each increment makes its solver afresh).
+    /// aggregate without them, and the field split drops its splits (and with them the
+    /// displacement block's yield zone); each increment makes its iterative solver afresh.
     pub fn reset(&mut self) -> Result<(), PetscError> {
         // SAFETY: live SNES we own; its PC is borrowed from it; the matrices and vectors it
         // referenced stay owned by us. The two-level cycle has no reset of its own.
@@ -410,11 +412,23 @@ unsafe extern "C" fn jacobian_cb(
             return PETSC_ERR_USER;
         }
     }
-    {
+    let zone = catch_unwind(AssertUnwindSafe(|| {
         // SAFETY: PETSc keeps x alive during the callback.
         let x = unsafe { VecRef::lent(x) };
-        if let Err(e) = update_yield_zone(snes, x, ctx) {
+        update_yield_zone(snes, x, ctx)
+    }));
+    match zone {
+        Ok(Ok(())) => {}
+        Ok(Err(e)) => {
             ctx_note(ctx, Some(()), &e.to_string());
+            return PETSC_ERR_USER;
+        }
+        Err(_) => {
+            ctx_note(
+                ctx,
+                Some(()),
+                "internal error: a panic in the yield zone's update",
+            );
             return PETSC_ERR_USER;
         }
     }

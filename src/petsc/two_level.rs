@@ -340,48 +340,25 @@ unsafe extern "C" fn apply_cb(pc: ffi::PC, b: ffi::Vec, x: ffi::Vec) -> ffi::Pet
 }
 
 unsafe extern "C" fn view_cb(pc: ffi::PC, viewer: ffi::PetscViewer) -> ffi::PetscErrorCode {
-    // SAFETY: PETSc keeps the viewer alive during the callback.
+    // SAFETY: PETSc keeps the viewer alive during the callback; the coarse solver is live.
     unsafe {
         with_cycle(pc, |c| {
-            let format = super::init::cstring("%s\n")?;
-            for line in [
+            let lines = [
                 format!(
                     "fine level (P2): one Richardson-Jacobi sweep before and after, damping \
                      factor={}",
                     c.damping
                 ),
                 "coarse level (P1):".to_string(),
-            ] {
-                let line = super::init::cstring(&line)?;
-                check(
-                    ffi::PetscViewerASCIIPrintf(viewer, format.as_ptr(), line.as_ptr()),
-                    "PetscViewerASCIIPrintf",
-                )?;
-            }
-            check(
-                ffi::PetscViewerASCIIPushTab(viewer),
-                "PetscViewerASCIIPushTab",
-            )?;
-            check(ffi::KSPView(c.coarse, viewer), "KSPView(coarse)")?;
-            check(
-                ffi::PetscViewerASCIIPopTab(viewer),
-                "PetscViewerASCIIPopTab",
-            )
+            ];
+            super::shell::view_nested(viewer, &lines, || {
+                check(ffi::KSPView(c.coarse, viewer), "KSPView(coarse)")
+            })
         })
     }
 }
 
 unsafe extern "C" fn destroy_cb(pc: ffi::PC) -> ffi::PetscErrorCode {
-    let mut raw: *mut c_void = std::ptr::null_mut();
-    // SAFETY: the context is the Box `set` leaked; PETSc calls destroy once.
-    unsafe {
-        let code = ffi::PCShellGetContext(pc, &mut raw as *mut *mut c_void as *mut c_void);
-        if code != 0 {
-            return code;
-        }
-        if !raw.is_null() {
-            release(*Box::from_raw(raw as *mut TwoLevel));
-        }
-    }
-    0
+    // SAFETY: the context is the Box `set` leaked.
+    unsafe { super::shell::reclaim::<TwoLevel>(pc, release) }
 }

@@ -40,6 +40,11 @@ struct YieldZone {
     zone_solution: ffi::Vec,
     /// The block's residual.
     residual: ffi::Vec,
+    /// The zone's rows of a vector of the block (made once per set-up: a sub-vector of an
+    /// arbitrary index set would build it at every application).
+    scatter: ffi::VecScatter,
+    /// The zone is every row: the exact solve alone is the preconditioner.
+    whole: bool,
     /// Rows of the zone over all ranks, and of the block, at the last set-up.
     zone_size: Int,
     block_size: Int,
@@ -95,6 +100,8 @@ pub(super) unsafe fn install(
             zone_rhs: std::ptr::null_mut(),
             zone_solution: std::ptr::null_mut(),
             residual: std::ptr::null_mut(),
+            scatter: std::ptr::null_mut(),
+            whole: false,
             zone_size: 0,
             block_size: 0,
             configured: false,
@@ -312,6 +319,8 @@ unsafe fn free_zone(z: &mut YieldZone) {
         }
         ffi::MatDestroy(matrix);
         ffi::ISDestroy(is);
+        ffi::VecScatterDestroy(&mut z.scatter);
+        z.whole = false;
     }
 }
 
@@ -363,68 +372,123 @@ unsafe extern "C" fn setup_cb(pc: ffi::PC) -> ffi::PetscErrorCode {
     // SAFETY: the operators and the zone's objects are live while the preconditioner is.
     unsafe {
         with_zone(pc, |z| {
-            let (a, p) = operators(pc)?;
-            check(ffi::PCSetOperators(z.amg, a, p), "PCSetOperators(amg)")?;
-            if !z.configured {
-                check(ffi::PCSetFromOptions(z.amg), "PCSetFromOptions(amg)")
-                    .map_err(PetscError::naming_user_options)?;
-                check(ffi::KSPSetFromOptions(z.exact), "KSPSetFromOptions(zone)")
-                    .map_err(PetscError::naming_user_options)?;
-                z.configured = true;
-            }
-            check(ffi::PCSetUp(z.amg), "PCSetUp(amg)")?;
+            // The last zone's factors go before GAMG builds its new hierarchy.
             free_zone(z);
             // A new zone is a new matrix, of another size: the factorisation starts afresh.
             check(ffi::KSPReset(z.exact), "KSPReset(zone)")?;
-            check(
-                ffi::MatCreateVecs(p, &mut z.residual, std::ptr::null_mut()),
-                "MatCreateVecs",
-            )?;
-            check(
-                ffi::MatGetSize(p, &mut z.block_size, std::ptr::null_mut()),
-                "MatGetSize",
-            )?;
-            let mut comm = mpi::ffi::RSMPI_COMM_NULL;
-            check(
-                ffi::PetscObjectGetComm(pc as ffi::PetscObject, &mut comm),
-                "PetscObjectGetComm",
-            )?;
-            check(
-                ffi::ISCreateGeneral(
-                    comm,
-                    to_int(z.rows.len(), "zone rows")?,
-                    z.rows.as_ptr(),
-                    ffi::PetscCopyMode_PETSC_COPY_VALUES,
-                    &mut z.zone,
-                ),
-                "ISCreateGeneral(zone)",
-            )?;
-            check(ffi::ISGetSize(z.zone, &mut z.zone_size), "ISGetSize(zone)")?;
-            if z.zone_size == 0 {
-                ffi::ISDestroy(&mut z.zone);
-                return Ok(());
+            let made = set_up(pc, z);
+            if made.is_err() {
+                free_zone(z);
             }
-            check(
-                ffi::MatCreateSubMatrix(
-                    p,
-                    z.zone,
-                    z.zone,
-                    ffi::MatReuse_MAT_INITIAL_MATRIX,
-                    &mut z.zone_matrix,
-                ),
-                "MatCreateSubMatrix(zone)",
-            )?;
-            check(
-                ffi::KSPSetOperators(z.exact, z.zone_matrix, z.zone_matrix),
-                "KSPSetOperators(zone)",
-            )?;
-            check(ffi::KSPSetUp(z.exact), "KSPSetUp(zone)")?;
-            check(
-                ffi::MatCreateVecs(z.zone_matrix, &mut z.zone_solution, &mut z.zone_rhs),
-                "MatCreateVecs(zone)",
-            )
+            made
         })
     }
+}
+
+/// Collective. [`setup_cb`]'s work on a freed zone.
+///
+/// # Safety
+/// `pc` must be the live shell whose zone `z` is.
+unsafe fn set_up(pc: ffi::PC, z: &mut YieldZone) -> Result<(), PetscError> {
+    // SAFETY: as the caller promises; every handle made here is the zone's own.
+    unsafe {
+        let (a, p) = operators(pc)?;
+        if !z.configured {
+            check(ffi::PCSetOperators(z.amg, a, p), "PCSetOperators(amg)")?;
+            check(ffi::PCSetFromOptions(z.amg), "PCSetFromOptions(amg)")
+                .map_err(PetscError::naming_user_options)?;
+            check(ffi::KSPSetFromOptions(z.exact), "KSPSetFromOptions(zone)")
+                .map_err(PetscError::naming_user_options)?;
+            z.configured = true;
+        }
+        check(
+            ffi::MatGetSize(p, &mut z.block_size, std::ptr::null_mut()),
+            "MatGetSize",
+        )?;
+        let mut comm = mpi::ffi::RSMPI_COMM_NULL;
+        check(
+            ffi::PetscObjectGetComm(pc as ffi::PetscObject, &mut comm),
+            "PetscObjectGetComm",
+        )?;
+        check(
+            ffi::ISCreateGeneral(
+                comm,
+                to_int(z.rows.len(), "zone rows")?,
+                z.rows.as_ptr(),
+                ffi::PetscCopyMode_PETSC_COPY_VALUES,
+                &mut z.zone,
+            ),
+            "ISCreateGeneral(zone)",
+        )?;
+        check(ffi::ISGetSize(z.zone, &mut z.zone_size), "ISGetSize(zone)")?;
+        // Where everything has yielded GAMG adds nothing to the exact solve.
+        z.whole = z.zone_size > 0 && z.zone_size == z.block_size;
+        if !z.whole {
+            check(ffi::PCSetOperators(z.amg, a, p), "PCSetOperators(amg)")?;
+            check(ffi::PCSetUp(z.amg), "PCSetUp(amg)")?;
+            pass_failure(z.amg, pc)?;
+        }
+        if z.zone_size == 0 {
+            ffi::ISDestroy(&mut z.zone);
+            return Ok(());
+        }
+        check(
+            ffi::MatCreateSubMatrix(
+                p,
+                z.zone,
+                z.zone,
+                ffi::MatReuse_MAT_INITIAL_MATRIX,
+                &mut z.zone_matrix,
+            ),
+            "MatCreateSubMatrix(zone)",
+        )?;
+        check(
+            ffi::KSPSetOperators(z.exact, z.zone_matrix, z.zone_matrix),
+            "KSPSetOperators(zone)",
+        )?;
+        check(ffi::KSPSetUp(z.exact), "KSPSetUp(zone)")?;
+        check(
+            ffi::MatCreateVecs(z.zone_matrix, &mut z.zone_solution, &mut z.zone_rhs),
+            "MatCreateVecs(zone)",
+        )?;
+        check(
+            ffi::MatCreateVecs(p, &mut z.residual, std::ptr::null_mut()),
+            "MatCreateVecs",
+        )?;
+        check(
+            ffi::VecScatterCreate(
+                z.residual,
+                z.zone,
+                z.zone_rhs,
+                std::ptr::null_mut(),
+                &mut z.scatter,
+            ),
+            "VecScatterCreate(zone)",
+        )
+    }
+}
+
+/// Marks `pc` failed (PETSc's `PC_SUBPC_ERROR`, which the outer Krylov method reports as
+/// `DIVERGED_PC_FAILED`) when its inner `amg` failed.
+///
+/// # Safety
+/// Both must be live.
+unsafe fn pass_failure(amg: ffi::PC, pc: ffi::PC) -> Result<(), PetscError> {
+    let mut reason: ffi::PCFailedReason = ffi::PCFailedReason_PC_NOERROR;
+    // SAFETY: as the caller promises.
+    unsafe {
+        check(
+            ffi::PCGetFailedReason(amg, &mut reason),
+            "PCGetFailedReason(amg)",
+        )?;
+        if reason != ffi::PCFailedReason_PC_NOERROR {
+            check(
+                ffi::PCSetFailedReason(pc, ffi::PCFailedReason_PC_SUBPC_ERROR),
+                "PCSetFailedReason",
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// Collective. x = GAMG(b), then the zone's rows corrected by the exact solve of the zone on
@@ -434,7 +498,11 @@ unsafe extern "C" fn apply_cb(pc: ffi::PC, b: ffi::Vec, x: ffi::Vec) -> ffi::Pet
     // SAFETY: PETSc keeps b and x alive during the callback; the zone's objects are live.
     unsafe {
         with_zone(pc, |z| {
+            if z.whole {
+                return solve_zone(pc, z, b, x, ffi::InsertMode_INSERT_VALUES);
+            }
             check(ffi::PCApply(z.amg, b, x), "PCApply(amg)")?;
+            pass_failure(z.amg, pc)?;
             if z.zone.is_null() {
                 return Ok(());
             }
@@ -442,79 +510,82 @@ unsafe extern "C" fn apply_cb(pc: ffi::PC, b: ffi::Vec, x: ffi::Vec) -> ffi::Pet
             let r = z.residual;
             check(ffi::MatMult(a, x, r), "MatMult")?;
             check(ffi::VecAYPX(r, -1.0, b), "VecAYPX")?;
-            let mut part: ffi::Vec = std::ptr::null_mut();
-            check(
-                ffi::VecGetSubVector(r, z.zone, &mut part),
-                "VecGetSubVector",
-            )?;
-            let copied = check(ffi::VecCopy(part, z.zone_rhs), "VecCopy");
-            check(
-                ffi::VecRestoreSubVector(r, z.zone, &mut part),
-                "VecRestoreSubVector",
-            )?;
-            copied?;
-            check(
-                ffi::KSPSolve(z.exact, z.zone_rhs, z.zone_solution),
-                "KSPSolve(zone)",
-            )?;
-            check(
-                ffi::KSPCheckSolve(z.exact, pc, z.zone_solution),
-                "KSPCheckSolve(zone)",
-            )?;
-            check(
-                ffi::VecGetSubVector(x, z.zone, &mut part),
-                "VecGetSubVector",
-            )?;
-            let added = check(ffi::VecAXPY(part, 1.0, z.zone_solution), "VecAXPY");
-            check(
-                ffi::VecRestoreSubVector(x, z.zone, &mut part),
-                "VecRestoreSubVector",
-            )?;
-            added
+            solve_zone(pc, z, r, x, ffi::InsertMode_ADD_VALUES)
         })
     }
 }
 
+/// Collective. x = x + A_zz⁻¹ r on the zone's rows (`ADD_VALUES`), or x = A_zz⁻¹ r there
+/// (`INSERT_VALUES`, the zone being every row).
+///
+/// # Safety
+/// `pc` must be the live shell whose set-up zone `z` is; `r`, `x` live vectors of the block.
+unsafe fn solve_zone(
+    pc: ffi::PC,
+    z: &YieldZone,
+    r: ffi::Vec,
+    x: ffi::Vec,
+    mode: ffi::InsertMode,
+) -> Result<(), PetscError> {
+    // SAFETY: as the caller promises.
+    unsafe {
+        let forward = ffi::ScatterMode_SCATTER_FORWARD;
+        let reverse = ffi::ScatterMode_SCATTER_REVERSE;
+        let insert = ffi::InsertMode_INSERT_VALUES;
+        check(
+            ffi::VecScatterBegin(z.scatter, r, z.zone_rhs, insert, forward),
+            "VecScatterBegin(zone)",
+        )?;
+        check(
+            ffi::VecScatterEnd(z.scatter, r, z.zone_rhs, insert, forward),
+            "VecScatterEnd(zone)",
+        )?;
+        check(
+            ffi::KSPSolve(z.exact, z.zone_rhs, z.zone_solution),
+            "KSPSolve(zone)",
+        )?;
+        check(
+            ffi::KSPCheckSolve(z.exact, pc, z.zone_solution),
+            "KSPCheckSolve(zone)",
+        )?;
+        check(
+            ffi::VecScatterBegin(z.scatter, z.zone_solution, x, mode, reverse),
+            "VecScatterBegin(zone back)",
+        )?;
+        check(
+            ffi::VecScatterEnd(z.scatter, z.zone_solution, x, mode, reverse),
+            "VecScatterEnd(zone back)",
+        )
+    }
+}
+
 unsafe extern "C" fn view_cb(pc: ffi::PC, viewer: ffi::PetscViewer) -> ffi::PetscErrorCode {
-    // SAFETY: PETSc keeps the viewer alive during the callback.
+    // SAFETY: PETSc keeps the viewer alive during the callback; the inner solvers are live.
     unsafe {
         with_zone(pc, |z| {
-            let format = cstring("%s\n")?;
-            let line = cstring(&format!(
-                "yielded zone: {} of {} rows, solved exactly after GAMG",
+            let how = if z.whole {
+                "solved exactly (GAMG skipped)"
+            } else {
+                "solved exactly after GAMG"
+            };
+            let line = format!(
+                "yielded zone: {} of {} rows, {how}",
                 z.zone_size, z.block_size
-            ))?;
-            check(
-                ffi::PetscViewerASCIIPrintf(viewer, format.as_ptr(), line.as_ptr()),
-                "PetscViewerASCIIPrintf",
-            )?;
-            check(
-                ffi::PetscViewerASCIIPushTab(viewer),
-                "PetscViewerASCIIPushTab",
-            )?;
-            check(ffi::PCView(z.amg, viewer), "PCView(amg)")?;
-            if !z.zone.is_null() {
-                check(ffi::KSPView(z.exact, viewer), "KSPView(zone)")?;
-            }
-            check(
-                ffi::PetscViewerASCIIPopTab(viewer),
-                "PetscViewerASCIIPopTab",
-            )
+            );
+            super::shell::view_nested(viewer, &[line], || {
+                if !z.whole {
+                    check(ffi::PCView(z.amg, viewer), "PCView(amg)")?;
+                }
+                if !z.zone.is_null() {
+                    check(ffi::KSPView(z.exact, viewer), "KSPView(zone)")?;
+                }
+                Ok(())
+            })
         })
     }
 }
 
 unsafe extern "C" fn destroy_cb(pc: ffi::PC) -> ffi::PetscErrorCode {
-    let mut raw: *mut c_void = std::ptr::null_mut();
-    // SAFETY: the context is the Box `install` leaked; PETSc calls destroy once.
-    unsafe {
-        let code = ffi::PCShellGetContext(pc, &mut raw as *mut *mut c_void as *mut c_void);
-        if code != 0 {
-            return code;
-        }
-        if !raw.is_null() {
-            release(*Box::from_raw(raw as *mut YieldZone));
-        }
-    }
-    0
+    // SAFETY: the context is the Box `install` leaked.
+    unsafe { super::shell::reclaim::<YieldZone>(pc, release) }
 }

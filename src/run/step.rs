@@ -30,6 +30,8 @@ pub struct SolverObjects {
     near_null: Option<NullSpace>,
     split: Option<Split>,
     pmg: Option<PMultigrid>,
+    /// The linear solver asks for the yielded zone at every Jacobian.
+    yield_zone: bool,
     snes: Snes,
 }
 
@@ -323,7 +325,7 @@ impl Simulation {
             // Plastic scenes are left to an explicit choice: at yield the iterative paths solve
             // the yielded zone exactly (GAMG alone does not converge there, on the field
             // split's displacement block or on a P2 system), so they cost a direct solve of
-            // the zone on top of the iterations: 2.6–3.1 times the direct path's time on
+            // the zone on top of the iterations: 2–3 times the direct path's time on
             // footing-shallow at 1.8 k–28 k particles (bench/VALIDATION.md, "The field split
             // at yield, solved").
             LinearChoice::Auto => {
@@ -381,9 +383,13 @@ impl Simulation {
                 let (d_nnz, o_nnz) = dofs.preallocation();
                 Mat::aij(world, dofs.n_owned_dofs, dofs.block_size(), &d_nnz, &o_nnz)?
             };
+        let yield_zone = iterative
+            && self.model.plastic()
+            && crate::petsc::linear::yield_zone_from_options(split.is_some())?;
         let linear = match &split {
             Some(s) => LinearSolver::Schur {
                 rtol: SCHUR_RTOL,
+                yield_zone,
                 displacement: &s.displacement_field,
                 pressure: &s.pressure_field,
                 pressure_mass: &s.pressure_mass,
@@ -400,7 +406,7 @@ impl Simulation {
             None if iterative => LinearSolver::Amg {
                 rtol: AMG_RTOL,
                 symmetric: self.symmetric_tangent(),
-                yield_zone: self.model.plastic(),
+                yield_zone,
             },
             None => LinearSolver::Direct {
                 reuse: crate::petsc::FactorReuse::from_options(solver.reuse_factorisation)?,
@@ -428,6 +434,7 @@ impl Simulation {
             near_null: None,
             split,
             pmg,
+            yield_zone,
             snes,
         })
     }
@@ -500,13 +507,14 @@ impl Simulation {
             near_null,
             split,
             pmg,
+            yield_zone,
             ..
         } = objects;
         let mut problem =
             StepProblem::new(world, mesh, dofs, setup, x).map_err(|e| err(e.to_string()))?;
         if iterative {
             problem = problem.without_element_cache();
-            if self.model.plastic() {
+            if *yield_zone {
                 problem = problem.with_yielded_zone();
             }
         }
