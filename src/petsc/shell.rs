@@ -222,3 +222,90 @@ pub(super) unsafe fn reclaim<T>(pc: ffi::PC, release: unsafe fn(T)) -> ffi::Pets
     }
     0
 }
+
+/// Runs a shell preconditioner's callback body `f` on its context, a `T` (see
+/// [`run_callback`]), or fails when `pc` is not the shell named `name` (`what` names it in
+/// messages).
+///
+/// # Safety
+/// `pc` must be live, and a shell named `name` must have a `T` as its context.
+pub(super) unsafe fn with_shell<T>(
+    pc: ffi::PC,
+    name: &str,
+    what: &str,
+    f: impl FnOnce(&mut T) -> Result<(), PetscError>,
+) -> ffi::PetscErrorCode {
+    run_callback(what, || {
+        // SAFETY: as the caller promises.
+        match unsafe { super::shell_context(pc, name) }? {
+            Some(raw) => f(unsafe { &mut *(raw as *mut T) }),
+            None => Err(not_shell(what)),
+        }
+    })
+}
+
+/// The error of a call that needs the shell `what` on a preconditioner that is not it.
+pub(super) fn not_shell(what: &str) -> PetscError {
+    PetscError {
+        code: PETSC_ERR_USER,
+        message: format!("the preconditioner is not the {what}"),
+    }
+}
+
+/// The callbacks of a shell preconditioner.
+pub(super) struct ShellOps {
+    pub setup: unsafe extern "C" fn(ffi::PC) -> ffi::PetscErrorCode,
+    pub apply: unsafe extern "C" fn(ffi::PC, ffi::Vec, ffi::Vec) -> ffi::PetscErrorCode,
+    pub view: unsafe extern "C" fn(ffi::PC, ffi::PetscViewer) -> ffi::PetscErrorCode,
+    pub destroy: unsafe extern "C" fn(ffi::PC) -> ffi::PetscErrorCode,
+}
+
+/// Collective. Makes `pc` a PCSHELL named `name` with `ops` and the context `context`, taken
+/// over: `ops.destroy` hands it to `release` ([`reclaim`]), or this does if the shell cannot
+/// be made. Returns the context, owned by the preconditioner.
+///
+/// # Safety
+/// `pc` must be live; `ops.destroy` must reclaim a `Box<T>` with `release`.
+pub(super) unsafe fn make_shell<T>(
+    pc: ffi::PC,
+    context: T,
+    name: &str,
+    release: unsafe fn(T),
+    ops: ShellOps,
+) -> Result<*mut T, PetscError> {
+    let (kind, name) = match (super::init::cstring("shell"), super::init::cstring(name)) {
+        (Ok(kind), Ok(name)) => (kind, name),
+        (Err(e), _) | (_, Err(e)) => {
+            // SAFETY: the caller's context is released as it would be on destroy.
+            unsafe { release(context) };
+            return Err(e);
+        }
+    };
+    let raw = Box::into_raw(Box::new(context));
+    // SAFETY: `pc` is live; the context is a leaked Box that the destroy callback reclaims
+    // exactly once; until that callback is registered, a failure reclaims it here.
+    unsafe {
+        let registered = check(ffi::PCSetType(pc, kind.as_ptr()), "PCSetType(shell)")
+            .and_then(|()| {
+                check(
+                    ffi::PCShellSetContext(pc, raw as *mut c_void),
+                    "PCShellSetContext",
+                )
+            })
+            .and_then(|()| {
+                check(
+                    ffi::PCShellSetDestroy(pc, Some(ops.destroy)),
+                    "PCShellSetDestroy",
+                )
+            });
+        if let Err(e) = registered {
+            release(*Box::from_raw(raw));
+            return Err(e);
+        }
+        check(ffi::PCShellSetName(pc, name.as_ptr()), "PCShellSetName")?;
+        check(ffi::PCShellSetSetUp(pc, Some(ops.setup)), "PCShellSetSetUp")?;
+        check(ffi::PCShellSetApply(pc, Some(ops.apply)), "PCShellSetApply")?;
+        check(ffi::PCShellSetView(pc, Some(ops.view)), "PCShellSetView")?;
+    }
+    Ok(raw)
+}

@@ -9,9 +9,9 @@
 use super::error::{check, PetscError};
 use super::ffi;
 use super::vector::VecRef;
-use std::ffi::c_void;
 
-const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
+/// What messages call it.
+const WHAT: &str = "two-level p-multigrid";
 /// The shell's name, which tells the cycle from our other shells.
 const NAME: &str = "p-multigrid (P2 Richardson-Jacobi, P1 coarse solver)";
 
@@ -51,11 +51,8 @@ pub(super) unsafe fn set(
     interpolation: ffi::Mat,
     coarse: ffi::KSP,
 ) -> Result<(), PetscError> {
-    let kind = super::init::cstring("shell")?;
-    let name = super::init::cstring(NAME)?;
-    // SAFETY: the caller's objects are live; the context is a leaked Box that the destroy
-    // callback reclaims exactly once; until it is registered, a failure reclaims it here
-    // (releasing the interpolation's reference and the coarse solver).
+    // SAFETY: the caller's objects are live; the cycle holds a reference to each, which
+    // `make_shell` hands to the preconditioner (or releases if it cannot).
     unsafe {
         if let Err(e) = check(
             ffi::PetscObjectReference(interpolation as ffi::PetscObject),
@@ -65,7 +62,7 @@ pub(super) unsafe fn set(
             ffi::KSPDestroy(&mut coarse);
             return Err(e);
         }
-        let raw = Box::into_raw(Box::new(TwoLevel {
+        let cycle = TwoLevel {
             interpolation,
             coarse,
             inverse_diagonal: std::ptr::null_mut(),
@@ -73,25 +70,18 @@ pub(super) unsafe fn set(
             coarse_rhs: std::ptr::null_mut(),
             coarse_solution: std::ptr::null_mut(),
             damping: 1.0,
-        })) as *mut c_void;
-        let registered = check(ffi::PCSetType(pc, kind.as_ptr()), "PCSetType(shell)")
-            .and_then(|()| check(ffi::PCShellSetContext(pc, raw), "PCShellSetContext"))
-            .and_then(|()| {
-                check(
-                    ffi::PCShellSetDestroy(pc, Some(destroy_cb)),
-                    "PCShellSetDestroy",
-                )
-            });
-        if let Err(e) = registered {
-            release(*Box::from_raw(raw as *mut TwoLevel));
-            return Err(e);
-        }
-        check(ffi::PCShellSetName(pc, name.as_ptr()), "PCShellSetName")?;
-        check(ffi::PCShellSetSetUp(pc, Some(setup_cb)), "PCShellSetSetUp")?;
-        check(ffi::PCShellSetApply(pc, Some(apply_cb)), "PCShellSetApply")?;
-        check(ffi::PCShellSetView(pc, Some(view_cb)), "PCShellSetView")
+        };
+        super::shell::make_shell(pc, cycle, NAME, release, OPS).map(|_| ())
     }
 }
+
+/// The cycle's callbacks.
+const OPS: super::shell::ShellOps = super::shell::ShellOps {
+    setup: setup_cb,
+    apply: apply_cb,
+    view: view_cb,
+    destroy: destroy_cb,
+};
 
 /// The cycle behind `pc`, if `pc` is one.
 ///
@@ -120,7 +110,7 @@ pub(super) unsafe fn coarse_solver(pc: ffi::PC) -> Result<ffi::KSP, PetscError> 
     // SAFETY: as the caller promises.
     match unsafe { context(pc) }? {
         Some(c) => Ok(c.coarse),
-        None => Err(not_two_level()),
+        None => Err(super::shell::not_shell(WHAT)),
     }
 }
 
@@ -135,7 +125,7 @@ pub(super) unsafe fn set_damping(pc: ffi::PC, damping: f64) -> Result<(), PetscE
             c.damping = damping;
             Ok(())
         }
-        None => Err(not_two_level()),
+        None => Err(super::shell::not_shell(WHAT)),
     }
 }
 
@@ -156,7 +146,7 @@ pub(super) unsafe fn set_residual(pc: ffi::PC, residual: ffi::Vec) -> Result<(),
                 c.residual = residual;
                 Ok(())
             }
-            None => Err(not_two_level()),
+            None => Err(super::shell::not_shell(WHAT)),
         }
     }
 }
@@ -193,13 +183,6 @@ pub(super) unsafe fn reset(pc: ffi::PC) -> Result<(), PetscError> {
     Ok(())
 }
 
-fn not_two_level() -> PetscError {
-    PetscError {
-        code: PETSC_ERR_USER,
-        message: "the preconditioner is not the two-level p-multigrid".into(),
-    }
-}
-
 /// Drops every reference the cycle holds.
 ///
 /// # Safety
@@ -221,13 +204,8 @@ unsafe fn with_cycle(
     pc: ffi::PC,
     f: impl FnOnce(&mut TwoLevel) -> Result<(), PetscError>,
 ) -> ffi::PetscErrorCode {
-    super::shell::run_callback("p-multigrid", || {
-        // SAFETY: PETSc calls back with the live shell `set` made.
-        match unsafe { context(pc) }? {
-            Some(c) => f(c),
-            None => Err(not_two_level()),
-        }
-    })
+    // SAFETY: PETSc calls back with the live shell `set` made.
+    unsafe { super::shell::with_shell(pc, NAME, WHAT, f) }
 }
 
 /// The operator of the coarse solver `coarse`, borrowed from it.

@@ -14,11 +14,11 @@ use super::init::cstring;
 use super::matrix::to_int;
 use super::vector::VecRef;
 use super::Int;
-use std::ffi::c_void;
 
-const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
 /// The shell's name, which tells our shell from any other.
 const NAME: &str = "yield zone (GAMG on the block, exact solve on the yielded rows)";
+/// What messages call it.
+const WHAT: &str = "yield zone";
 /// The key under which the outer preconditioner holds the displacement block's.
 const KEY: &str = "pfem_yield_zone";
 
@@ -79,11 +79,9 @@ pub(super) unsafe fn install(
     outer: ffi::PC,
     prefix: &str,
 ) -> Result<(), PetscError> {
-    let kind = cstring("shell")?;
-    let name = cstring(NAME)?;
     let key = cstring(KEY)?;
-    // SAFETY: the caller's objects are live; the context is a leaked Box that the destroy
-    // callback reclaims exactly once; until it is registered, a failure reclaims it here.
+    // SAFETY: the caller's objects are live; the zone's references go to the preconditioner
+    // with it (`make_shell`), or are released on a failure before.
     unsafe {
         let mut comm = mpi::ffi::RSMPI_COMM_NULL;
         check(
@@ -118,23 +116,7 @@ pub(super) unsafe fn install(
             release(zone);
             return Err(e);
         }
-        let raw = Box::into_raw(Box::new(zone)) as *mut c_void;
-        let registered = check(ffi::PCSetType(pc, kind.as_ptr()), "PCSetType(shell)")
-            .and_then(|()| check(ffi::PCShellSetContext(pc, raw), "PCShellSetContext"))
-            .and_then(|()| {
-                check(
-                    ffi::PCShellSetDestroy(pc, Some(destroy_cb)),
-                    "PCShellSetDestroy",
-                )
-            });
-        if let Err(e) = registered {
-            release(*Box::from_raw(raw as *mut YieldZone));
-            return Err(e);
-        }
-        check(ffi::PCShellSetName(pc, name.as_ptr()), "PCShellSetName")?;
-        check(ffi::PCShellSetSetUp(pc, Some(setup_cb)), "PCShellSetSetUp")?;
-        check(ffi::PCShellSetApply(pc, Some(apply_cb)), "PCShellSetApply")?;
-        check(ffi::PCShellSetView(pc, Some(view_cb)), "PCShellSetView")?;
+        let raw = super::shell::make_shell(pc, zone, NAME, release, OPS)?;
         if outer != pc {
             check(
                 ffi::PetscObjectCompose(
@@ -145,7 +127,7 @@ pub(super) unsafe fn install(
                 "PetscObjectCompose(yield zone)",
             )?;
         }
-        let z = &mut *(raw as *mut YieldZone);
+        let z = &mut *raw;
         let zone_prefix = cstring(&format!("{prefix}zone_"))?;
         let prefix = cstring(prefix)?;
         check(
@@ -179,6 +161,14 @@ pub(super) unsafe fn install(
         )
     }
 }
+
+/// The zone's callbacks.
+const OPS: super::shell::ShellOps = super::shell::ShellOps {
+    setup: setup_cb,
+    apply: apply_cb,
+    view: view_cb,
+    destroy: destroy_cb,
+};
 
 /// The yield-zone preconditioner of the field split `outer`, if it has one.
 ///
@@ -231,7 +221,7 @@ pub(super) unsafe fn set_zone(
     // SAFETY: as the caller promises; the marker is ours and destroyed here.
     unsafe {
         let Some(z) = context(pc)? else {
-            return Err(not_ours());
+            return Err(super::shell::not_shell(WHAT));
         };
         let marker = template.duplicate()?;
         check(ffi::VecSet(marker.raw, 0.0), "VecSet")?;
@@ -282,13 +272,6 @@ pub(super) unsafe fn set_zone(
         }
         z.rows = read?;
         Ok(())
-    }
-}
-
-fn not_ours() -> PetscError {
-    PetscError {
-        code: PETSC_ERR_USER,
-        message: "the displacement block's preconditioner is not the yield zone".into(),
     }
 }
 
@@ -347,13 +330,8 @@ unsafe fn with_zone(
     pc: ffi::PC,
     f: impl FnOnce(&mut YieldZone) -> Result<(), PetscError>,
 ) -> ffi::PetscErrorCode {
-    super::shell::run_callback("yield zone", || {
-        // SAFETY: PETSc calls back with the live shell `install` made.
-        match unsafe { context(pc) }? {
-            Some(z) => f(z),
-            None => Err(not_ours()),
-        }
-    })
+    // SAFETY: PETSc calls back with the live shell `install` made.
+    unsafe { super::shell::with_shell(pc, NAME, WHAT, f) }
 }
 
 /// The operators (Amat, Pmat) of `pc`.
