@@ -563,7 +563,7 @@ unsafe fn install_yield_zone(pc: ffi::PC, displacement: &IndexSet) -> Result<(),
         check(freed, "PetscFree")?;
         let Some(ksp) = first else {
             return Err(PetscError {
-                code: 83,
+                code: super::error::PETSC_ERR_USER,
                 message: "the field split has no displacement block".into(),
             });
         };

@@ -1,7 +1,7 @@
 //! Matrices that PETSc applies through our callbacks (MATSHELL): operators cheaper to apply
 //! than to store.
 
-use super::error::{check, PetscError};
+use super::error::{check, PetscError, PETSC_ERR_USER};
 use super::ffi;
 use super::matrix::{to_int, Mat};
 use super::vector::VecRef;
@@ -23,8 +23,6 @@ pub trait LinearOperator {
 
 /// The context PETSc keeps: a thin pointer to the operator.
 type Context = Box<dyn LinearOperator>;
-
-const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
 
 impl Mat {
     /// Collective. A shell matrix with `local` (rows, columns) sizes that applies `op`. PETSc

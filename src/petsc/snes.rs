@@ -1,4 +1,4 @@
-use super::error::{check, PetscError};
+use super::error::{check, PetscError, PETSC_ERR_USER};
 use super::ffi;
 use super::init::cstring;
 use super::linear::{bool_option, FactorReuse, LinearSolver};
@@ -87,7 +87,6 @@ fn update_yield_zone(snes: ffi::SNES, x: VecRef<'_>, ctx: &mut Ctx) -> Result<()
     Ok(())
 }
 
-const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
 /// Newton also stops when its update is this small relative to the solution: with a good
 /// predictor the first residual is already small, and a residual tolerance relative to it alone
 /// can lie below round-off.
@@ -396,61 +395,43 @@ unsafe extern "C" fn jacobian_cb(
     if code != 0 {
         return code;
     }
-    if ctx.damped_smoother {
-        let damped = match ctx.problem.smoother_damping() {
-            Some(damping) => damp_smoother(snes, damping),
-            None => Err(PetscError {
-                code: PETSC_ERR_USER,
-                message: "the p-multigrid's Jacobi smoother has no damping: this Jacobian gave \
-                          no finite bound on its spectrum (an element tangent with a negative \
-                          or zero diagonal, or not a number)"
-                    .into(),
-            }),
-        };
-        if let Err(e) = damped {
-            ctx_note(ctx, Some(()), &e.to_string());
-            return PETSC_ERR_USER;
-        }
-    }
-    let zone = catch_unwind(AssertUnwindSafe(|| {
+    let after = catch_unwind(AssertUnwindSafe(|| {
         // SAFETY: PETSc keeps x alive during the callback.
-        let x = unsafe { VecRef::lent(x) };
-        update_yield_zone(snes, x, ctx)
+        after_jacobian(snes, unsafe { VecRef::lent(x) }, ctx)
     }));
-    match zone {
-        Ok(Ok(())) => {}
-        Ok(Err(e)) => {
-            ctx_note(ctx, Some(()), &e.to_string());
-            return PETSC_ERR_USER;
-        }
-        Err(_) => {
-            ctx_note(
-                ctx,
-                Some(()),
-                "internal error: a panic in the yield zone's update",
-            );
-            return PETSC_ERR_USER;
-        }
+    let message = match after {
+        Ok(Ok(())) => return 0,
+        Ok(Err(e)) => e.to_string(),
+        Err(_) => "internal error: a panic after the Jacobian".to_string(),
+    };
+    ctx_note(ctx, Some(()), &message);
+    PETSC_ERR_USER
+}
+
+/// Collective. What the linear solver takes from a new Jacobian at `x`: the p-multigrid's
+/// smoother damping, the yield zone, the coarse solver's first set-up, and whether a kept
+/// factorisation is refreshed.
+fn after_jacobian(snes: ffi::SNES, x: VecRef<'_>, ctx: &mut Ctx) -> Result<(), PetscError> {
+    if ctx.damped_smoother {
+        let damping = ctx.problem.smoother_damping().ok_or_else(|| PetscError {
+            code: PETSC_ERR_USER,
+            message: "the p-multigrid's Jacobi smoother has no damping: this Jacobian gave no \
+                      finite bound on its spectrum (an element tangent with a negative or zero \
+                      diagonal, or not a number)"
+                .into(),
+        })?;
+        damp_smoother(snes, damping)?;
     }
+    update_yield_zone(snes, x, ctx)?;
     if ctx.coarse_first {
         ctx.coarse_first = false;
-        // SAFETY: PETSc keeps x alive during the callback.
-        let x = unsafe { VecRef::lent(x) };
-        if let Err(e) = set_up_coarse_solver(snes).and_then(|()| share_work_vector(snes, x)) {
-            ctx_note(ctx, Some(()), &e.to_string());
-            return PETSC_ERR_USER;
-        }
+        set_up_coarse_solver(snes)?;
+        share_work_vector(snes, x)?;
     }
-    match ctx.reuse {
-        Some(reuse) => match choose_factorisation(snes, &reuse, &mut ctx.last_norm) {
-            Ok(()) => 0,
-            Err(e) => {
-                ctx_note(ctx, Some(()), &e.to_string());
-                PETSC_ERR_USER
-            }
-        },
-        None => 0,
+    if let Some(reuse) = ctx.reuse {
+        choose_factorisation(snes, &reuse, &mut ctx.last_norm)?;
     }
+    Ok(())
 }
 
 /// The preconditioner of `snes`'s linear solver, borrowed from it.
