@@ -160,20 +160,20 @@ fn fields<'a>(p: &Part, v: &'a Values) -> Vec<Field<'a>> {
     let t = time(p.step);
     vec![
         Field::Scalar(
-            "pressure",
+            "pressure".into(),
             p.position
                 .iter()
                 .map(|&[x, y]| (3.0 * x).sin() + y * y)
                 .collect(),
         ),
-        Field::ScalarRef("level", &v.level),
-        Field::VectorRef("velocity", &v.velocity),
+        Field::ScalarRef("level".into(), &v.level),
+        Field::VectorRef("velocity".into(), &v.velocity),
         Field::Vector(
-            "flow",
+            "flow".into(),
             p.position.iter().map(|&[x, y]| [x.cos(), t * y]).collect(),
         ),
         Field::Tensor(
-            "stress",
+            "stress".into(),
             p.position
                 .iter()
                 .map(|&[x, y]| [x, y, x + y, x * y])
@@ -280,7 +280,7 @@ fn bad_frames(world: &SimpleCommunicator, c: &mut Checks, w: &mut FieldsWriter) 
     // A field of the wrong length on rank 0 only.
     let mut f = frame(&p, &v, &owner);
     if world.rank() == 0 {
-        f.point_data[0] = Field::Scalar("pressure", vec![0.0; p.gid.len() + 1]);
+        f.point_data[0] = Field::Scalar("pressure".into(), vec![0.0; p.gid.len() + 1]);
     }
     expect_error(
         world,
@@ -359,7 +359,7 @@ fn bad_frames(world: &SimpleCommunicator, c: &mut Checks, w: &mut FieldsWriter) 
 
     // A reserved or malformed field name.
     let mut f = frame(&p, &v, &owner);
-    f.point_data[0] = Field::Scalar("a/b", vec![0.0; p.gid.len()]);
+    f.point_data[0] = Field::Scalar("a/b".into(), vec![0.0; p.gid.len()]);
     expect_error(
         world,
         c,
@@ -433,7 +433,7 @@ fn run(world: &SimpleCommunicator, c: &mut Checks, dir: &Path) {
             time: 0.0,
             gid: &[],
             position: &[],
-            point_data: vec![Field::Vector("u", Vec::new())],
+            point_data: vec![Field::Vector("u".into(), Vec::new())],
             triangles: &[],
             owner_of: &nobody,
         };

@@ -1,12 +1,12 @@
 //! Case files: the complete state of an analysis (scene, progress, particles) in one HDF5 file,
 //! used both to start a case and as a checkpoint to restart from.
 //!
-//! Format version 1. Root attributes:
+//! Format version 2 (version 1 files are read too). Root attributes:
 //!
 //! | name | type | meaning |
 //! |---|---|---|
 //! | `format` | string | always `"pfem-mpi case"` |
-//! | `format_version` | u32 | 1 |
+//! | `format_version` | u32 | 2 |
 //! | `code_version` | string | version of the pfem-mpi that wrote the file |
 //! | `scene` | string | the full resolved scene as TOML (overrides and defaults applied) |
 //! | `scene_source` | string | scene file name or built-in name |
@@ -19,8 +19,12 @@
 //!
 //! Datasets in group `/particles`, n = global particle count, one row per particle:
 //! `gid` (u64, n), `position` (f64, n x 2, current), `displacement` (f64, n x 2, total since the
-//! start), `h` (f64, n), `state` (f64, n x 9), `flags` (u32, n), `increment` (f64, n x 2, the
-//! last step's displacement increment).
+//! start), `h` (f64, n), `state` (f64, n x w), `flags` (u32, n), `increment` (f64, n x 2, the
+//! last step's displacement increment). `state` holds one row of the material's layout per
+//! particle: w = 4 stress components plus the model's internal variables, named column by
+//! column in its string-array attribute `names` (`state_columns.rs`; version 1 had no attribute
+//! and w = 9 for every model: stress, plastic strain, `eps_q`). A reader matches the columns by
+//! name against the scene's material.
 //!
 //! Group `/gauss` (checkpoints): see `case_file/gauss.rs`. Every dataset carries an attribute
 //! `checksum` (u64, `case_file/checksum.rs`), checked on reading; files written before it have
@@ -52,6 +56,8 @@ mod header;
 mod lockstep;
 #[path = "case_file/particles.rs"]
 mod particles;
+#[path = "case_file/state_columns.rs"]
+mod state_columns;
 #[path = "case_file/summary.rs"]
 mod summary;
 #[path = "case_file/validate.rs"]
@@ -71,8 +77,8 @@ use mpi::traits::*;
 
 pub use collective::block_range;
 pub use error::{CaseError, CaseErrorKind};
-pub use gauss::{GaussRecords, CONTACT_LEN, GAUSS_LEN, NODE_LEN};
-pub use particles::{ParticleSet, STATE_LEN};
+pub use gauss::{GaussRecords, CONTACT_LEN, GAUSS_POINTS, NODE_LEN};
+pub use particles::ParticleSet;
 pub use write::{write_case, write_checkpoint};
 
 use crate::scene::{generate_particles, lattice, Scene};
@@ -82,7 +88,7 @@ pub(crate) use lockstep::{estimate as estimate_bytes, write_hdf5, Lockstep};
 /// Value of the `format` attribute.
 pub const FORMAT: &str = "pfem-mpi case";
 /// Format version written by this program, and the newest it reads.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 /// Everything in a case file except the particles.
 #[derive(Debug, Clone, PartialEq)]
@@ -107,6 +113,9 @@ pub struct CaseHeader {
     /// Particles written by each rank, in rank order ([`write_case`] records them). A reader
     /// with the same rank count takes the same blocks, so a restart keeps the partition.
     pub rank_counts: Vec<u64>,
+    /// The name of each column of a state row (the scene's material's layout): what the `names`
+    /// attribute of the state datasets holds. A read case has been conformed to its scene.
+    pub state_columns: Vec<String>,
 }
 
 /// A new case at step 0: the scene's particle lattice and, for each point load, the particle
@@ -142,6 +151,7 @@ pub fn new_case(scene: &Scene, source: &str) -> (CaseHeader, ParticleSet) {
         next_gid: particles.len() as u64,
         ranks: 1,
         tracked_gids,
+        state_columns: crate::model::state_layout(scene).columns(),
         rank_counts: Vec::new(),
     };
     (header, particles)
@@ -241,8 +251,13 @@ pub fn check_output(
 type Block = (CaseHeader, ParticleSet, usize, u64);
 
 fn read_contents(comm: &SimpleCommunicator, file: &File, path: &Path) -> Result<Block, CaseError> {
-    let header = agree(comm, path, header::read_header(file, path))?;
-    let (ds, n) = agree(comm, path, datasets::open_all(file, path))?;
+    let mut header = agree(comm, path, header::read_header(file, path))?;
+    let (ds, n, width) = agree(comm, path, datasets::open_all(file, path))?;
+    header.state_columns = agree(
+        comm,
+        path,
+        stored_columns(&header, &ds[4], path, "particles"),
+    )?;
     let block = same_blocks(&header, n, comm)
         .unwrap_or_else(|| block_range(n, comm.size() as u64, comm.rank() as u64));
     let rows = block.start as usize..block.end as usize;
@@ -253,10 +268,10 @@ fn read_contents(comm: &SimpleCommunicator, file: &File, path: &Path) -> Result<
         displacement: vec![[0.0; 2]; count],
         increment: vec![[0.0; 2]; count],
         h: vec![0.0; count],
-        state: vec![[0.0; STATE_LEN]; count],
+        state: crate::material::Rows::zeros(width, count),
         flags: vec![0; count],
     };
-    let [gid, position, displacement, h, state, flags, increment] = datasets::columns();
+    let [gid, position, displacement, h, state, flags, increment] = datasets::columns(width);
     let read = (|| {
         read_column(
             &ds[6],
@@ -278,12 +293,7 @@ fn read_contents(comm: &SimpleCommunicator, file: &File, path: &Path) -> Result<
             p.displacement.as_flattened_mut(),
         )?;
         read_column(&ds[3], h.width, rows.clone(), &mut p.h)?;
-        read_column(
-            &ds[4],
-            state.width,
-            rows.clone(),
-            p.state.as_flattened_mut(),
-        )?;
+        read_column(&ds[4], state.width, rows.clone(), p.state.as_flat_mut())?;
         read_column(&ds[5], flags.width, rows, &mut p.flags)
     })()
     .map_err(|e| {
@@ -308,7 +318,7 @@ fn read_contents(comm: &SimpleCommunicator, file: &File, path: &Path) -> Result<
         (&h, checksum::verify(comm, &ds[3], first, 0, &p.h)),
         (
             &state,
-            checksum::verify(comm, &ds[4], first, STATE_LEN, p.state.as_flattened()),
+            checksum::verify(comm, &ds[4], first, width, p.state.as_flat()),
         ),
         (&flags, checksum::verify(comm, &ds[5], first, 0, &p.flags)),
         (
@@ -330,6 +340,54 @@ fn read_contents(comm: &SimpleCommunicator, file: &File, path: &Path) -> Result<
 }
 
 /// The block this rank wrote, when the file was written by as many ranks as read it.
+/// The column names of a state dataset: its `names` attribute, or version 1's fixed nine.
+fn stored_columns(
+    header: &CaseHeader,
+    ds: &Dataset,
+    path: &Path,
+    group: &str,
+) -> Result<Vec<String>, CaseError> {
+    let bad = |m: String| {
+        CaseError::new(path, CaseErrorKind::Malformed, m).at(format!(
+            "attribute {} of dataset /{group}/state",
+            state_columns::ATTR
+        ))
+    };
+    match state_columns::stored(ds) {
+        Some(names) => names.map_err(|e| bad(format!("unreadable: {e}"))),
+        None if header.format_version == 1 => Ok(state_columns::version_1()),
+        None => Err(bad("missing".to_string())),
+    }
+}
+
+/// The state rows of a read block rearranged to the layout of the scene's material
+/// (`state_columns::conform`); `header.state_columns` then names the scene's columns. A scene
+/// that does not parse is left for the header checks to report.
+fn conform_states(
+    header: &mut CaseHeader,
+    particles: &mut ParticleSet,
+    gauss: Option<(&mut GaussRecords, Vec<String>)>,
+    path: &Path,
+) -> Result<(), CaseError> {
+    let Ok(scene) = Scene::from_toml(&header.scene_toml, &path.display().to_string(), &[]) else {
+        return Ok(());
+    };
+    let to = crate::model::state_layout(&scene).columns();
+    let fill = header.format_version == 1;
+    let at = |group: &str, m: String| {
+        CaseError::new(path, CaseErrorKind::Malformed, m).at(format!("dataset /{group}/state"))
+    };
+    let rows = std::mem::take(&mut particles.state);
+    particles.state = state_columns::conform(rows, 1, &header.state_columns, &to, fill)
+        .map_err(|m| at("particles", m))?;
+    if let Some((g, from)) = gauss {
+        let rows = std::mem::take(&mut g.state);
+        g.state = state_columns::conform(rows, 3, &from, &to, fill).map_err(|m| at("gauss", m))?;
+    }
+    header.state_columns = to;
+    Ok(())
+}
+
 fn same_blocks(header: &CaseHeader, n: u64, comm: &SimpleCommunicator) -> Option<Range<u64>> {
     let counts = &header.rank_counts;
     if counts.len() != comm.size() as usize || counts.iter().sum::<u64>() != n {
@@ -347,10 +405,15 @@ pub fn read_checkpoint(
     comm: &SimpleCommunicator,
     path: &Path,
 ) -> Result<(CaseHeader, ParticleSet, GaussRecords), CaseError> {
-    let (header, particles, first, n) = read_block(comm, path)?;
+    let (mut header, mut particles, first, n) = read_block(comm, path)?;
     let opened = mpio_file(comm, path, false).map_err(|e| open_error(path, e));
     let file = agree(comm, path, opened)?;
     let records = agree(comm, path, gauss::read(comm, &file, path));
+    let gauss_columns = match file.group("gauss").and_then(|g| g.dataset("state")) {
+        Ok(ds) => stored_columns(&header, &ds, path, "gauss"),
+        Err(_) => Ok(header.state_columns.clone()),
+    };
+    let gauss_columns = agree(comm, path, gauss_columns);
     let verified = match &records {
         Ok(g) => {
             let (first, _) = pfem_partition::exscan_u64(comm, g.len() as u64);
@@ -362,7 +425,16 @@ pub fn read_checkpoint(
         .close()
         .map_err(|e| CaseError::new(path, CaseErrorKind::Io, format!("cannot close: {e}")));
     let records = records.and_then(|g| verified.map(|_| g));
-    let records = agree(comm, path, records.and_then(|g| closed.map(|_| g)))?;
+    let mut records = agree(comm, path, records.and_then(|g| closed.map(|_| g)))?;
+    let conformed = gauss_columns.and_then(|from| {
+        conform_states(
+            &mut header,
+            &mut particles,
+            Some((&mut records, from)),
+            path,
+        )
+    });
+    agree(comm, path, conformed)?;
     validate_blocks::validate_blocks(comm, path, &header, &particles, first, n, &records)?;
     Ok((header, particles, records))
 }
@@ -376,7 +448,10 @@ pub fn read_case(
     comm: &SimpleCommunicator,
     path: &Path,
 ) -> Result<(CaseHeader, ParticleSet), CaseError> {
-    read_block(comm, path).map(|(h, p, _, _)| (h, p))
+    let (mut h, mut p, _, _) = read_block(comm, path)?;
+    let conformed = conform_states(&mut h, &mut p, None, path);
+    agree(comm, path, conformed)?;
+    Ok((h, p))
 }
 
 fn read_block(comm: &SimpleCommunicator, path: &Path) -> Result<Block, CaseError> {

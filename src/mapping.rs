@@ -1,80 +1,89 @@
 //! State transfer between meshes, rank-local. After a step the Gauss states are recovered at the
 //! particles (Gauss point → vertex extrapolation, area-weighted average); after a remesh a triangle
 //! that survived unchanged keeps its Gauss states exactly, and a new triangle interpolates the
-//! particle values at its Gauss points. Both directions reproduce linear fields exactly.
+//! particle values at its Gauss points. Both directions reproduce linear fields exactly. Every
+//! column of the material's layout is transferred alike, so the layout's width is all this
+//! module knows of it.
 
 use crate::fem::element::p2_gauss_points;
 use crate::fem::p2::straight_sided;
-use crate::fem::recovery::{barycentric, extrapolate_to_vertices, interpolate_linear};
-use crate::material::GaussState;
+use crate::fem::recovery::{barycentric, GAUSS_TO_VERTEX};
+use crate::material::{GaussState, Rows};
 use crate::mesh::LocalMesh;
 
-const K: usize = GaussState::LEN;
+/// Gauss points per triangle: a triangle's state row holds this many rows of the layout.
+pub const POINTS: usize = 3;
 
-/// The start-of-step Gauss states of every local triangle, as the step reads them. An elastic
-/// law's plastic fields are zero, so its states keep the stress alone: stored whole they were
-/// five ninths of the states' 71 MB at the solve's memory peak (the cantilever at h = 1/128,
-/// 1 rank).
+/// The start-of-step Gauss states of every local triangle, as the step reads them: one row of
+/// [`POINTS`] layout rows per triangle. An elastic law's layout is the stress alone, so its
+/// states cost no more than the stress.
 #[derive(Debug, Clone)]
-pub enum StartStates {
-    Full(Vec<[GaussState; 3]>),
-    StressOnly(Vec<[[f64; 4]; 3]>),
-}
+pub struct StartStates(Rows);
 
 impl StartStates {
-    /// `states` per triangle; `plastic` keeps every field, else the stress alone (the plastic
-    /// fields must then be zero).
-    pub fn new(states: Vec<[GaussState; 3]>, plastic: bool) -> StartStates {
-        if plastic {
-            return StartStates::Full(states);
-        }
-        debug_assert!(states
-            .iter()
-            .flatten()
-            .all(|g| g.plastic_strain == [0.0; 4] && g.eps_q == 0.0));
-        StartStates::StressOnly(states.iter().map(|s| s.map(|g| g.stress)).collect())
+    pub fn new(states: Rows) -> StartStates {
+        StartStates(states)
     }
 
     /// The states of triangle `t`.
-    pub fn get(&self, t: usize) -> [GaussState; 3] {
-        match self {
-            StartStates::Full(s) => s[t],
-            StartStates::StressOnly(s) => s[t].map(|stress| GaussState {
-                stress,
-                ..GaussState::default()
-            }),
-        }
+    pub fn get(&self, t: usize) -> [GaussState; POINTS] {
+        let row = self.0.row(t);
+        let w = row.len() / POINTS;
+        std::array::from_fn(|q| GaussState::from_row(&row[q * w..(q + 1) * w]))
     }
+}
+
+/// Appends a triangle's Gauss states as one row.
+pub fn push_states(rows: &mut Rows, states: &[GaussState; POINTS]) {
+    let w = rows.width() / POINTS;
+    let mut row = [0.0; 64];
+    let mut heap;
+    let buf: &mut [f64] = if rows.width() <= row.len() {
+        &mut row[..rows.width()]
+    } else {
+        heap = vec![0.0; rows.width()];
+        &mut heap
+    };
+    for (q, s) in states.iter().enumerate() {
+        s.write_to(&mut buf[q * w..(q + 1) * w]);
+    }
+    rows.push(buf);
 }
 
 /// Gauss states of a mesh's triangles, looked up by global-id key.
 #[derive(Debug, Clone, Default)]
 pub struct TriStates {
     keys: Vec<[u64; 3]>,
-    states: Vec<[GaussState; 3]>,
+    states: Rows,
 }
 
 impl TriStates {
-    /// `states[t]` belongs to `mesh.tris[t]` (whose keys are sorted).
-    pub fn new(mesh: &LocalMesh, states: Vec<[GaussState; 3]>) -> TriStates {
+    /// `states` row t belongs to `mesh.tris[t]` (whose keys are sorted).
+    pub fn new(mesh: &LocalMesh, states: Rows) -> TriStates {
         let keys = (0..mesh.tris.len()).map(|t| mesh.tri_key(t)).collect();
         TriStates { keys, states }
     }
 
-    /// From unordered (key, states) pairs; a key given twice keeps its first states.
-    pub fn from_pairs(mut pairs: Vec<([u64; 3], [GaussState; 3])>) -> TriStates {
-        pairs.sort_by_key(|p| p.0);
-        pairs.dedup_by_key(|p| p.0);
-        let (keys, states) = pairs.into_iter().unzip();
-        TriStates { keys, states }
+    /// From unordered keys and their rows; a key given twice keeps its first states.
+    pub fn from_pairs(keys: Vec<[u64; 3]>, states: Rows) -> TriStates {
+        let mut order: Vec<usize> = (0..keys.len()).collect();
+        order.sort_by_key(|&i| keys[i]);
+        order.dedup_by_key(|i| keys[*i]);
+        TriStates {
+            keys: order.iter().map(|&i| keys[i]).collect(),
+            states: states.permuted(&order),
+        }
     }
 
-    pub fn iter(&self) -> impl Iterator<Item = (&[u64; 3], &[GaussState; 3])> {
-        self.keys.iter().zip(&self.states)
+    pub fn iter(&self) -> impl Iterator<Item = (&[u64; 3], &[f64])> {
+        self.keys.iter().zip(self.states.iter())
     }
 
-    pub fn get(&self, key: &[u64; 3]) -> Option<&[GaussState; 3]> {
-        self.keys.binary_search(key).ok().map(|i| &self.states[i])
+    pub fn get(&self, key: &[u64; 3]) -> Option<&[f64]> {
+        self.keys
+            .binary_search(key)
+            .ok()
+            .map(|i| self.states.row(i))
     }
 
     /// Drops the triangles with a vertex in `moved` (their Gauss points are no longer where the
@@ -90,14 +99,10 @@ impl TriStates {
             i += 1;
             keep[i - 1]
         });
-        let mut j = 0;
-        self.states.retain(|_| {
-            j += 1;
-            keep[j - 1]
-        });
+        self.states.retain(&keep);
     }
 
-    pub fn states(&self) -> &[[GaussState; 3]] {
+    pub fn states(&self) -> &Rows {
         &self.states
     }
 }
@@ -112,70 +117,80 @@ pub struct MapStats {
 }
 
 /// States for `mesh`'s triangles: kept where the triangle existed before (same three global
-/// ids), otherwise interpolated linearly from the particle values `at_points` (indexed like
-/// `mesh.points`). Both inputs are bitwise identical on every rank that holds the triangle (the
-/// particle values travel with the halo), so every copy of an interface triangle gets the same
-/// states. (Interpolating from the old triangle that contains a new Gauss point would smooth less,
-/// but a rank does not hold every old triangle around its ghost triangles, so copies could differ.)
-pub fn map_states(
-    old: &TriStates,
-    mesh: &LocalMesh,
-    at_points: &[[f64; K]],
-) -> (Vec<[GaussState; 3]>, MapStats) {
+/// ids), otherwise interpolated linearly from the particle values `at_points` (a row per
+/// `mesh.points` entry). Both inputs are bitwise identical on every rank that holds the triangle
+/// (the particle values travel with the halo), so every copy of an interface triangle gets the
+/// same states. (Interpolating from the old triangle that contains a new Gauss point would smooth
+/// less, but a rank does not hold every old triangle around its ghost triangles, so copies could
+/// differ.)
+pub fn map_states(old: &TriStates, mesh: &LocalMesh, at_points: &Rows) -> (Rows, MapStats) {
+    let w = at_points.width();
     let mut stats = MapStats::default();
-    let states = (0..mesh.tris.len())
-        .map(|t| {
-            if let Some(s) = old.get(&mesh.tri_key(t)) {
-                stats.kept += 1;
-                return *s;
+    let mut states = Rows::with_capacity(POINTS * w, mesh.tris.len());
+    let mut row = vec![0.0; POINTS * w];
+    for t in 0..mesh.tris.len() {
+        if let Some(s) = old.get(&mesh.tri_key(t)) {
+            stats.kept += 1;
+            states.push(s);
+            continue;
+        }
+        stats.interpolated += 1;
+        stats.interpolated_owned += usize::from(mesh.tri_owned[t]);
+        let tri = mesh.tris[t];
+        let v = tri.map(|i| mesh.points[i as usize]);
+        let vals = tri.map(|i| at_points.row(i as usize));
+        for (q, p) in p2_gauss_points(&straight_sided(&v)).iter().enumerate() {
+            let bary = barycentric(v[0], v[1], v[2], *p);
+            let out = &mut row[q * w..(q + 1) * w];
+            out.fill(0.0);
+            for (l, vk) in bary.iter().zip(&vals) {
+                for (o, x) in out.iter_mut().zip(vk.iter()) {
+                    *o += l * x;
+                }
             }
-            stats.interpolated += 1;
-            stats.interpolated_owned += usize::from(mesh.tri_owned[t]);
-            let tri = mesh.tris[t];
-            let v = tri.map(|i| mesh.points[i as usize]);
-            let vals = tri.map(|i| at_points[i as usize]);
-            p2_gauss_points(&straight_sided(&v)).map(|p| {
-                GaussState::from_array(&interpolate_linear(barycentric(v[0], v[1], v[2], p), &vals))
-            })
-        })
-        .collect();
+        }
+        states.push(&row);
+    }
     (states, stats)
 }
 
 /// Particle values of the Gauss states: each triangle's linear extrapolation to its vertices,
 /// averaged over the triangles around an owned particle with their areas as weights. Owned
 /// particles in no triangle keep `previous`.
-pub fn recover_at_particles(
-    mesh: &LocalMesh,
-    states: &[[GaussState; 3]],
-    previous: &[[f64; K]],
-) -> Vec<[f64; K]> {
+pub fn recover_at_particles(mesh: &LocalMesh, states: &Rows, previous: &Rows) -> Rows {
     let n = mesh.n_owned;
-    let mut sum = vec![[0.0; K]; n];
+    let w = previous.width();
+    let mut sum = Rows::zeros(w, n);
     let mut weight = vec![0.0; n];
-    for (tri, s) in mesh.tris.iter().zip(states) {
+    let mut at_vertex = vec![0.0; w];
+    for (tri, s) in mesh.tris.iter().zip(states.iter()) {
         let [a, b, c] = tri.map(|v| mesh.points[v as usize]);
         let area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
-        let at_vertices = extrapolate_to_vertices(&s.map(|g| g.to_array()));
         for (k, &v) in tri.iter().enumerate() {
             let v = v as usize;
-            if v < n {
-                weight[v] += area;
-                for (acc, x) in sum[v].iter_mut().zip(&at_vertices[k]) {
-                    *acc += area * x;
+            if v >= n {
+                continue;
+            }
+            at_vertex.fill(0.0);
+            for (q, coeff) in GAUSS_TO_VERTEX[k].iter().enumerate() {
+                for (o, g) in at_vertex.iter_mut().zip(&s[q * w..(q + 1) * w]) {
+                    *o += coeff * g;
                 }
+            }
+            weight[v] += area;
+            for (acc, x) in sum.row_mut(v).iter_mut().zip(&at_vertex) {
+                *acc += area * x;
             }
         }
     }
-    (0..n)
-        .map(|i| {
-            if weight[i] > 0.0 {
-                sum[i].map(|x| x / weight[i])
-            } else {
-                previous[i]
-            }
-        })
-        .collect()
+    for (i, &wt) in weight.iter().enumerate() {
+        if wt > 0.0 {
+            sum.row_mut(i).iter_mut().for_each(|x| *x /= wt);
+        } else {
+            sum.row_mut(i).copy_from_slice(previous.row(i));
+        }
+    }
+    sum
 }
 
 #[cfg(test)]
@@ -210,37 +225,35 @@ mod tests {
         )
     }
 
-    fn states_of(mesh: &LocalMesh, f: &impl Fn([f64; 2]) -> f64) -> Vec<[GaussState; 3]> {
-        (0..mesh.tris.len())
-            .map(|t| {
-                let v = mesh.tris[t].map(|i| mesh.points[i as usize]);
-                p2_gauss_points(&straight_sided(&v)).map(|p| {
-                    let mut a = [0.0; K];
-                    for (k, x) in a.iter_mut().enumerate() {
-                        *x = f(p) * (k + 1) as f64;
-                    }
-                    GaussState::from_array(&a)
-                })
-            })
-            .collect()
+    const K: usize = 9;
+
+    fn states_of(mesh: &LocalMesh, f: &impl Fn([f64; 2]) -> f64) -> Rows {
+        let mut out = Rows::new(POINTS * K);
+        for t in 0..mesh.tris.len() {
+            let v = mesh.tris[t].map(|i| mesh.points[i as usize]);
+            let row: Vec<f64> = p2_gauss_points(&straight_sided(&v))
+                .iter()
+                .flat_map(|&p| (0..K).map(move |k| f(p) * (k + 1) as f64))
+                .collect();
+            out.push(&row);
+        }
+        out
     }
 
     /// Largest error at the new mesh's Gauss points after Gauss -> particle -> Gauss.
     fn round_trip_error(n: usize, f: impl Fn([f64; 2]) -> f64) -> f64 {
         let h = 1.0 / n as f64;
         let (a, b) = meshes(n, h);
-        let at_particles = recover_at_particles(&a, &states_of(&a, &f), &vec![[0.0; K]; a.n_owned]);
+        let at_particles = recover_at_particles(&a, &states_of(&a, &f), &Rows::zeros(K, a.n_owned));
         // Mesh b numbers the same points in reverse: its particle values are a's, reversed.
-        let on_b: Vec<[f64; K]> = (0..b.points.len()).map(|i| at_particles[i]).collect();
+        let on_b = at_particles.slice(0..b.points.len());
         let (mapped, stats) = map_states(&TriStates::default(), &b, &on_b);
         assert_eq!(stats.kept, 0);
         let exact = states_of(&b, &f);
         let mut worst: f64 = 0.0;
-        for (m, e) in mapped.iter().zip(&exact) {
-            for q in 0..3 {
-                for (x, y) in m[q].to_array().iter().zip(e[q].to_array()) {
-                    worst = worst.max((x - y).abs());
-                }
+        for (m, e) in mapped.iter().zip(exact.iter()) {
+            for (x, y) in m.iter().zip(e) {
+                worst = worst.max((x - y).abs());
             }
         }
         worst
@@ -266,7 +279,7 @@ mod tests {
         let (a, _) = meshes(4, 0.25);
         let states = states_of(&a, &|p| p[0] * p[0]);
         let old = TriStates::new(&a, states.clone());
-        let (mapped, stats) = map_states(&old, &a, &vec![[0.0; K]; a.points.len()]);
+        let (mapped, stats) = map_states(&old, &a, &Rows::zeros(K, a.points.len()));
         assert_eq!(stats.interpolated, 0);
         assert_eq!(mapped, states);
     }

@@ -2,10 +2,20 @@
 
 use crate::material::elastic::LinearElastic;
 use crate::material::tresca::Tresca;
-use crate::material::Material;
+use crate::material::{Material, StateLayout};
 use crate::rigid::RigidBody;
 use crate::scene::{Axis, ElementChoice, MaterialModel, Prescribed, Scene, Selection};
 use crate::solve::Kernel;
+
+/// The layout of the state rows of a scene's material: what case files, checkpoints and output
+/// hold per particle and Gauss point. It depends on the model alone (not on its parameters), so
+/// it is known before the parameters are checked.
+pub fn state_layout(scene: &Scene) -> StateLayout {
+    match scene.material.model {
+        MaterialModel::LinearElastic => StateLayout::default(),
+        MaterialModel::Tresca => StateLayout::new(&crate::material::tresca::VARIABLES),
+    }
+}
 
 pub struct Model {
     pub material: Box<dyn Material>,
@@ -73,11 +83,26 @@ impl Model {
 
     /// Whether the material can yield (Newton then backtracks).
     pub fn plastic(&self) -> bool {
-        self.scene.material.model == MaterialModel::Tresca
+        self.material.yields()
+    }
+
+    /// The layout of every state row of the run.
+    pub fn layout(&self) -> StateLayout {
+        self.material.layout()
     }
 
     pub fn mixed(&self) -> bool {
         matches!(self.kernel, Kernel::P2P1 { .. })
+    }
+
+    /// The body force at load factor `lambda`: `density * g`, scaled by `lambda` under
+    /// `gravity.ramp`.
+    pub fn body_force_at(&self, lambda: f64) -> [f64; 2] {
+        if self.scene.gravity.ramp {
+            self.body_force.map(|b| lambda * b)
+        } else {
+            self.body_force
+        }
     }
 
     /// Load factor at the end of `step` (equal increments).

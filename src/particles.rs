@@ -1,6 +1,6 @@
 //! The particles one rank owns, sorted by global id, and the halo copies of its neighbours'.
 
-use crate::material::GaussState;
+use crate::material::Rows;
 use pfem_partition::{Comm, Halo, PartitionError};
 
 /// Per-particle flags.
@@ -21,8 +21,9 @@ pub struct Particles {
     pub increment: Vec<[f64; 2]>,
     /// Target spacing.
     pub h: Vec<f64>,
-    /// State carried by the particle (Gauss state recovered at the particle).
-    pub state: Vec<[f64; GaussState::LEN]>,
+    /// State carried by the particle (Gauss state recovered at the particle), one row of the
+    /// material's layout each.
+    pub state: Rows,
     pub flags: Vec<u32>,
 }
 
@@ -35,11 +36,12 @@ pub struct Ghosts {
     pub displacement: Vec<[f64; 2]>,
     pub increment: Vec<[f64; 2]>,
     pub h: Vec<f64>,
-    pub state: Vec<[f64; GaussState::LEN]>,
+    pub state: Rows,
 }
 
-/// f64 record per particle in a halo exchange: position, displacement, increment, h, state.
-pub const RECORD: usize = 7 + GaussState::LEN;
+/// f64 values per particle in a halo exchange before its state row: position, displacement,
+/// increment, h.
+const FIXED: usize = 7;
 
 impl Particles {
     pub fn len(&self) -> usize {
@@ -66,38 +68,43 @@ impl Particles {
         self.displacement = order.iter().map(|&i| self.displacement[i]).collect();
         self.increment = order.iter().map(|&i| self.increment[i]).collect();
         self.h = order.iter().map(|&i| self.h[i]).collect();
-        self.state = order.iter().map(|&i| self.state[i]).collect();
+        self.state = self.state.permuted(&order);
         self.flags = order.iter().map(|&i| self.flags[i]).collect();
+    }
+
+    /// f64 values per particle in [`Particles::records`].
+    pub fn record_len(&self) -> usize {
+        FIXED + self.state.width()
     }
 
     /// Flattens the f64 fields for exchange and migration.
     pub fn records(&self) -> Vec<f64> {
-        let mut out = Vec::with_capacity(self.len() * RECORD);
+        let mut out = Vec::with_capacity(self.len() * self.record_len());
         for i in 0..self.len() {
             out.extend_from_slice(&self.position[i]);
             out.extend_from_slice(&self.displacement[i]);
             out.extend_from_slice(&self.increment[i]);
             out.push(self.h[i]);
-            out.extend_from_slice(&self.state[i]);
+            out.extend_from_slice(self.state.row(i));
         }
         out
     }
 
-    /// Rebuilds from global ids, flattened records and flags.
-    pub fn from_records(gid: Vec<u64>, rec: &[f64], flags: Vec<u32>) -> Particles {
+    /// Rebuilds from global ids, flattened records of [`Particles::records`] (state rows of
+    /// `width`) and flags.
+    pub fn from_records(gid: Vec<u64>, rec: &[f64], width: usize, flags: Vec<u32>) -> Particles {
         let mut p = Particles {
             gid,
             flags,
+            state: Rows::with_capacity(width, rec.len() / (FIXED + width)),
             ..Default::default()
         };
-        for r in rec.chunks_exact(RECORD) {
+        for r in rec.chunks_exact(FIXED + width) {
             p.position.push([r[0], r[1]]);
             p.displacement.push([r[2], r[3]]);
             p.increment.push([r[4], r[5]]);
             p.h.push(r[6]);
-            let mut s = [0.0; GaussState::LEN];
-            s.copy_from_slice(&r[7..RECORD]);
-            p.state.push(s);
+            p.state.push(&r[FIXED..]);
         }
         p
     }
@@ -105,20 +112,20 @@ impl Particles {
     /// Collective. Builds the halo of width `width` and copies the neighbours' particles.
     pub fn ghosts(&self, comm: &Comm, width: f64) -> Result<(Halo, Ghosts), PartitionError> {
         let halo = Halo::build(comm, &self.gid, &self.position, width)?;
-        let rec = halo.exchange_f64(comm, &self.records(), RECORD);
+        let len = self.record_len();
+        let rec = halo.exchange_f64(comm, &self.records(), len);
         let mut g = Ghosts {
             gid: halo.ghost_ids().to_vec(),
             owner: halo.ghost_owners().to_vec(),
+            state: Rows::with_capacity(self.state.width(), rec.len() / len),
             ..Default::default()
         };
-        for r in rec.chunks_exact(RECORD) {
+        for r in rec.chunks_exact(len) {
             g.position.push([r[0], r[1]]);
             g.displacement.push([r[2], r[3]]);
             g.increment.push([r[4], r[5]]);
             g.h.push(r[6]);
-            let mut s = [0.0; GaussState::LEN];
-            s.copy_from_slice(&r[7..RECORD]);
-            g.state.push(s);
+            g.state.push(&r[FIXED..]);
         }
         Ok((halo, g))
     }

@@ -7,7 +7,8 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use pfem_mpi::case_file::validate::validate_case;
-use pfem_mpi::case_file::{new_case, CaseHeader, GaussRecords, ParticleSet, GAUSS_LEN};
+use pfem_mpi::case_file::{new_case, CaseHeader, GaussRecords, ParticleSet, GAUSS_POINTS};
+use pfem_mpi::material::Rows;
 use pfem_mpi::rng::next;
 use pfem_mpi::scene::load_scene;
 
@@ -25,7 +26,11 @@ fn base() -> (CaseHeader, ParticleSet, GaussRecords) {
             .iter()
             .position(|q| (q[0] - x[0]).abs() < 1e-9 && (q[1] - x[1]).abs() < 1e-9)
     };
-    let mut g = GaussRecords::default();
+    let width = GAUSS_POINTS * header.state_columns.len();
+    let mut g = GaussRecords {
+        state: Rows::new(width),
+        ..GaussRecords::default()
+    };
     for (i, x) in p.position.iter().enumerate() {
         let (Some(b), Some(c)) = (find([x[0] + 0.5, x[1]]), find([x[0] + 0.5, x[1] + 0.5])) else {
             continue;
@@ -34,7 +39,7 @@ fn base() -> (CaseHeader, ParticleSet, GaussRecords) {
         let k = (0..3).min_by_key(|&k| key[k]).unwrap();
         key.rotate_left(k);
         g.key.push(key);
-        g.state.push([1.0; GAUSS_LEN]);
+        g.state.push(&vec![1.0; width]);
         g.nodes.push([f64::NAN; 18]);
         g.contact.push([f64::NAN; 18]);
     }
@@ -96,9 +101,9 @@ fn corrupt(r: &mut Rng, h: &mut CaseHeader, p: &mut ParticleSet, g: &mut GaussRe
         }
         3 => {
             let v = r.pick(&NASTY);
-            let k = r.below(9);
-            if let Some(x) = p.state.get_mut(i) {
-                x[k] = v;
+            let k = r.below(p.state.width());
+            if i < p.state.len() {
+                p.state.row_mut(i)[k] = v;
             }
             bad(v)
         }
@@ -191,9 +196,9 @@ fn corrupt(r: &mut Rng, h: &mut CaseHeader, p: &mut ParticleSet, g: &mut GaussRe
         }
         13 => {
             let t = r.below(g.len());
-            let (k, v) = (r.below(GAUSS_LEN), r.pick(&NASTY[..3]));
-            if let Some(x) = g.state.get_mut(t) {
-                x[k] = v;
+            let (k, v) = (r.below(g.state.width()), r.pick(&NASTY[..3]));
+            if t < g.state.len() {
+                g.state.row_mut(t)[k] = v;
             }
             true
         }

@@ -488,7 +488,7 @@ fn rigid(coords: &[[f64; 2]]) -> Vec<Vec<f64>> {
 
 #[test]
 fn rigid_body_modes_are_in_the_kernel_of_the_stress_free_tangents() {
-    let states = [GaussState::default(); 3];
+    let states = <[GaussState; 3]>::default();
     let mat = LinearElastic::new(12.0e6, 0.3).expect("material");
     let p2 = kernel_residuals(
         0,

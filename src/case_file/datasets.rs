@@ -7,7 +7,7 @@ use hdf5::types::TypeDescriptor;
 use hdf5::{Dataset, File, Group, H5Type};
 
 use super::error::{CaseError, CaseErrorKind};
-use super::particles::STATE_LEN;
+use crate::material::STRESS_LEN;
 
 pub const GROUP: &str = "particles";
 
@@ -18,23 +18,24 @@ pub struct Column {
     pub dtype: TypeDescriptor,
 }
 
-/// The particle datasets, in the order they are written and checked.
-pub fn columns() -> [Column; 7] {
+/// The particle datasets, in the order they are written and checked, with state rows of
+/// `state_width` (the material's layout).
+pub fn columns(state_width: usize) -> [Column; 7] {
     let col = |name, width, dtype| Column { name, width, dtype };
     [
         col("gid", 0, u64::type_descriptor()),
         col("position", 2, f64::type_descriptor()),
         col("displacement", 2, f64::type_descriptor()),
         col("h", 0, f64::type_descriptor()),
-        col("state", STATE_LEN, f64::type_descriptor()),
+        col("state", state_width, f64::type_descriptor()),
         col("flags", 0, u32::type_descriptor()),
         col("increment", 2, f64::type_descriptor()),
     ]
 }
 
 /// Bytes of raw data per particle over all datasets.
-pub fn bytes_per_particle() -> u64 {
-    columns()
+pub fn bytes_per_particle(state_width: usize) -> u64 {
+    columns(state_width)
         .iter()
         .map(|c| (c.width.max(1) * c.dtype.size()) as u64)
         .sum()
@@ -55,8 +56,9 @@ fn shape_text(shape: &[usize]) -> String {
 }
 
 /// Opens every particle dataset and checks type and shape; returns them in `columns()` order
-/// with the particle count.
-pub fn open_all(file: &File, path: &Path) -> Result<(Vec<Dataset>, u64), CaseError> {
+/// with the particle count and the width of the state rows (the writer's layout, at least the
+/// stress).
+pub fn open_all(file: &File, path: &Path) -> Result<(Vec<Dataset>, u64, usize), CaseError> {
     let bad = |name: &str, message: String| {
         CaseError::new(path, CaseErrorKind::Malformed, message)
             .at(format!("dataset /{GROUP}/{name}"))
@@ -64,9 +66,22 @@ pub fn open_all(file: &File, path: &Path) -> Result<(Vec<Dataset>, u64), CaseErr
     let group = file.group(GROUP).map_err(|_| {
         CaseError::new(path, CaseErrorKind::Malformed, "missing").at(format!("group /{GROUP}"))
     })?;
+    let width = match group.dataset("state").map(|d| d.shape()) {
+        Ok(s) if s.len() == 2 && s[1] >= STRESS_LEN => s[1],
+        Ok(s) => {
+            return Err(bad(
+                "state",
+                format!(
+                    "expected shape (n, >= {STRESS_LEN}), found {}",
+                    shape_text(&s)
+                ),
+            ))
+        }
+        Err(_) => return Err(bad("state", "missing".to_string())),
+    };
     let mut out = Vec::new();
     let mut n: Option<u64> = None;
-    for c in columns() {
+    for c in columns(width) {
         let ds = group
             .dataset(c.name)
             .map_err(|_| bad(c.name, "missing".to_string()))?;
@@ -122,7 +137,7 @@ pub fn open_all(file: &File, path: &Path) -> Result<(Vec<Dataset>, u64), CaseErr
     }
     let n = n.unwrap_or(0);
     let file_len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(u64::MAX);
-    let need = n.saturating_mul(bytes_per_particle());
+    let need = n.saturating_mul(bytes_per_particle(width));
     if need > file_len {
         return Err(CaseError::new(
             path,
@@ -130,5 +145,5 @@ pub fn open_all(file: &File, path: &Path) -> Result<(Vec<Dataset>, u64), CaseErr
             format!("truncated: {n} particles need {need} bytes but the file has {file_len}"),
         ));
     }
-    Ok((out, n))
+    Ok((out, n, width))
 }

@@ -15,9 +15,12 @@ use super::collective::block_range;
 use super::error::{CaseError, CaseErrorKind};
 use super::ffi;
 use super::lockstep::Lockstep;
+use super::state_columns;
+use crate::material::{Rows, STRESS_LEN};
 
-/// Values per triangle: 3 Gauss points x 9 state values.
-pub const GAUSS_LEN: usize = 27;
+/// Gauss points per triangle: a state row of `/gauss/state` holds this many rows of the
+/// material's layout.
+pub const GAUSS_POINTS: usize = 3;
 /// Node values per triangle: 6 nodes (vertices in key order, then the midside nodes of edges
 /// 01, 12, 20) x (displacement increment per whole step x, y; pressure, NaN if none). A node
 /// the run did not keep is NaN throughout: a P2 vertex (its particle's increment is the same)
@@ -32,7 +35,8 @@ const GROUP: &str = "gauss";
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct GaussRecords {
     pub key: Vec<[u64; 3]>,
-    pub state: Vec<[f64; GAUSS_LEN]>,
+    /// [`GAUSS_POINTS`] state rows of the material's layout per triangle.
+    pub state: Rows,
     /// NaN where unknown (a file without `nodes`).
     pub nodes: Vec<[f64; NODE_LEN]>,
     /// NaN where no contact (or a file without `contact`).
@@ -75,20 +79,23 @@ fn column_step<T: H5Type + Word>(
     width: usize,
     (n, rows): (usize, Range<usize>),
     data: &[T],
-) -> Result<(), CaseError> {
+) -> Result<Dataset, CaseError> {
     let what = format!("dataset /{GROUP}/{name}");
     let ds = step.step(&what, column(file, name, width, n, rows.clone(), data))?;
     let sum = step.total(checksum::rows_sum(rows.start, width, data));
-    step.step(&what, checksum::put(&ds, sum))
+    step.step(&what, checksum::put(&ds, sum))?;
+    Ok(ds)
 }
 
-/// Collective: every rank writes its rows `rows` of `n`, one agreed step per dataset.
+/// Collective: every rank writes its rows `rows` of `n`, one agreed step per dataset; the state
+/// rows are laid out as `columns` names them.
 pub(crate) fn write(
     file: &File,
     step: &Lockstep<'_>,
     g: &GaussRecords,
     rows: Range<usize>,
     n: usize,
+    columns: &[String],
 ) -> Result<(), CaseError> {
     let at = || (n, rows.clone());
     column_step(step, file, "key", 3, at(), g.key.as_flattened())?;
@@ -101,7 +108,13 @@ pub(crate) fn write(
         at(),
         g.contact.as_flattened(),
     )?;
-    column_step(step, file, "state", GAUSS_LEN, at(), g.state.as_flattened())
+    let width = GAUSS_POINTS * columns.len();
+    let ds = column_step(step, file, "state", width, at(), g.state.as_flat())?;
+    let what = format!(
+        "attribute {} of dataset /{GROUP}/state",
+        state_columns::ATTR
+    );
+    step.step(&what, state_columns::put(&ds, columns))
 }
 
 /// Collective: a contiguous block of the records per rank (all empty when the group is absent).
@@ -126,17 +139,25 @@ pub fn read(
     if ks.len() != 2 || ks[1] != 3 {
         return Err(bad("key", format!("expected shape (m, 3), found {ks:?}")));
     }
-    if ss.len() != 2 || ss[1] != GAUSS_LEN || ss[0] != ks[0] {
+    let width = ss.get(1).copied().unwrap_or(0);
+    if ss.len() != 2
+        || width < GAUSS_POINTS * STRESS_LEN
+        || !width.is_multiple_of(GAUSS_POINTS)
+        || ss[0] != ks[0]
+    {
         return Err(bad(
             "state",
-            format!("expected shape ({}, {GAUSS_LEN}), found {ss:?}", ks[0]),
+            format!(
+                "expected shape ({}, {GAUSS_POINTS} x the state's width), found {ss:?}",
+                ks[0]
+            ),
         ));
     }
     let block = block_range(ks[0] as u64, comm.size() as u64, comm.rank() as u64);
     let rows = block.start as usize..block.end as usize;
     let mut g = GaussRecords {
         key: vec![[0; 3]; rows.len()],
-        state: vec![[0.0; GAUSS_LEN]; rows.len()],
+        state: Rows::zeros(width, rows.len()),
         nodes: vec![[f64::NAN; NODE_LEN]; rows.len()],
         contact: vec![[f64::NAN; CONTACT_LEN]; rows.len()],
     };
@@ -181,7 +202,7 @@ pub fn read(
         ffi::read_collective(
             &state,
             &state.space()?.select((rows, ..))?,
-            g.state.as_flattened_mut(),
+            g.state.as_flat_mut(),
         )
     })();
     read.map_err(|e| bad("state", format!("cannot read: {e}")))?;
@@ -213,5 +234,5 @@ pub fn verify(
     checksum::verify(comm, &key, first, 3, g.key.as_flattened()).map_err(|m| bad("key", m))?;
     check("nodes", NODE_LEN, g.nodes.as_flattened())?;
     check("contact", CONTACT_LEN, g.contact.as_flattened())?;
-    check("state", GAUSS_LEN, g.state.as_flattened())
+    check("state", g.state.width(), g.state.as_flat())
 }

@@ -204,5 +204,7 @@ pub fn read_header(file: &File, path: &Path) -> Result<CaseHeader, CaseError> {
         } else {
             Vec::new()
         },
+        // Read from the state datasets' `names` attribute with the particles.
+        state_columns: Vec::new(),
     })
 }

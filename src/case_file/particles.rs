@@ -1,7 +1,6 @@
 //! Particles as parallel arrays, the unit that case files store and ranks exchange.
 
-/// Number of per-particle state values (`ParticleSet::state`).
-pub const STATE_LEN: usize = 9;
+use crate::material::Rows;
 
 /// A set of particles, one entry per particle in each array (all arrays have the same length).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -16,21 +15,23 @@ pub struct ParticleSet {
     pub increment: Vec<[f64; 2]>,
     /// Local particle spacing (m).
     pub h: Vec<f64>,
-    /// Per-particle material state (stresses, plastic variables), meaning set by the material.
-    pub state: Vec<[f64; STATE_LEN]>,
+    /// Per-particle material state, one row of the material's layout each
+    /// ([`crate::material::StateLayout`]).
+    pub state: Rows,
     /// Per-particle bit flags.
     pub flags: Vec<u32>,
 }
 
 impl ParticleSet {
-    pub fn with_capacity(n: usize) -> Self {
+    /// Room for `n` particles with state rows of `width`.
+    pub fn with_capacity(n: usize, width: usize) -> Self {
         ParticleSet {
             gid: Vec::with_capacity(n),
             position: Vec::with_capacity(n),
             displacement: Vec::with_capacity(n),
             increment: Vec::with_capacity(n),
             h: Vec::with_capacity(n),
-            state: Vec::with_capacity(n),
+            state: Rows::with_capacity(width, n),
             flags: Vec::with_capacity(n),
         }
     }
@@ -50,7 +51,7 @@ impl ParticleSet {
         self.displacement.push([0.0; 2]);
         self.increment.push([0.0; 2]);
         self.h.push(h);
-        self.state.push([0.0; STATE_LEN]);
+        self.state.push_zeros();
         self.flags.push(0);
     }
 
@@ -62,7 +63,7 @@ impl ParticleSet {
             displacement: self.displacement[range.clone()].to_vec(),
             increment: self.increment[range.clone()].to_vec(),
             h: self.h[range.clone()].to_vec(),
-            state: self.state[range.clone()].to_vec(),
+            state: self.state.slice(range.clone()),
             flags: self.flags[range].to_vec(),
         }
     }

@@ -142,7 +142,7 @@ pub fn check_particles(
         let vectors = [
             ("displacement", &p.displacement[i][..]),
             ("increment", &p.increment[i][..]),
-            ("state", &p.state[i][..]),
+            ("state", p.state.row(i)),
         ];
         for (name, v) in vectors {
             if let Some(k) = v.iter().position(|v| !v.is_finite()) {
@@ -203,7 +203,7 @@ pub fn check_gauss_block(path: &Path, g: &GaussRecords, first: usize) -> Result<
                 ),
             ));
         }
-        if let Some(s) = g.state.get(t) {
+        if let Some(s) = (t < g.state.len()).then(|| g.state.row(t)) {
             if let Some(i) = s.iter().position(|v| !v.is_finite()) {
                 return Err(bad(
                     path,

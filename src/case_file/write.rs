@@ -13,8 +13,9 @@ use super::collective::agree;
 use super::datasets::{self, Column};
 use super::error::{CaseError, CaseErrorKind};
 use super::lockstep::{self, Lockstep};
+use super::state_columns;
 use super::{check_output, ffi, gauss, header, CaseHeader, GaussRecords, ParticleSet};
-use super::{CONTACT_LEN, GAUSS_LEN, NODE_LEN};
+use super::{CONTACT_LEN, GAUSS_POINTS, NODE_LEN};
 
 /// Writes this rank's rows `rows` of column `c` (collective).
 fn write_column<T: H5Type>(
@@ -43,11 +44,12 @@ fn column_step<T: H5Type + Word>(
     n: usize,
     rows: Range<usize>,
     data: &[T],
-) -> Result<(), CaseError> {
+) -> Result<Dataset, CaseError> {
     let what = format!("dataset /{}/{}", datasets::GROUP, c.name);
     let ds = step.step(&what, write_column(group, c, n, rows.clone(), data))?;
     let sum = step.total(checksum::rows_sum(rows.start, c.width, data));
-    step.step(&what, checksum::put(&ds, sum))
+    step.step(&what, checksum::put(&ds, sum))?;
+    Ok(ds)
 }
 
 /// Collective. The whole file, one agreed step per attribute set and dataset.
@@ -64,9 +66,10 @@ fn write_contents(
     gauss_rows: (Range<usize>, usize),
 ) -> Result<(), CaseError> {
     step.step("attributes", header::write_header(file, header, ranks))?;
-    gauss::write(file, step, gauss, gauss_rows.0, gauss_rows.1)?;
+    let names = &header.state_columns;
+    gauss::write(file, step, gauss, gauss_rows.0, gauss_rows.1, names)?;
     let group = step.step("group /particles", file.create_group(datasets::GROUP))?;
-    let [gid, position, displacement, h, state, flags, increment] = datasets::columns();
+    let [gid, position, displacement, h, state, flags, increment] = datasets::columns(names.len());
     let (g, r) = (&group, rows);
     column_step(step, g, &gid, n, r.clone(), &local.gid)?;
     column_step(
@@ -88,8 +91,13 @@ fn write_contents(
     let displacements = local.displacement.as_flattened();
     column_step(step, g, &displacement, n, r.clone(), displacements)?;
     column_step(step, g, &h, n, r.clone(), &local.h)?;
-    column_step(step, g, &state, n, r.clone(), local.state.as_flattened())?;
-    column_step(step, g, &flags, n, r, &local.flags)
+    let ds = column_step(step, g, &state, n, r.clone(), local.state.as_flat())?;
+    let what = format!(
+        "attribute {} of dataset /particles/state",
+        state_columns::ATTR
+    );
+    step.step(&what, state_columns::put(&ds, names))?;
+    column_step(step, g, &flags, n, r, &local.flags).map(drop)
 }
 
 /// Collective. Writes a case file: every rank passes its own particles (any count, zero
@@ -116,8 +124,21 @@ pub fn write_checkpoint(
     local: &ParticleSet,
     gauss: &GaussRecords,
 ) -> Result<(), CaseError> {
+    let width = header.state_columns.len();
     let checked = local
         .check_lengths()
+        .and_then(|_| {
+            let widths = [
+                (local.state.width(), width, "particle"),
+                (gauss.state.width(), GAUSS_POINTS * width, "Gauss"),
+            ];
+            match widths.iter().find(|(w, want, _)| *w != *want && *w != 0) {
+                Some((w, want, what)) => Err(format!(
+                    "{what} state rows of {w} values where the layout's columns make {want}"
+                )),
+                None => Ok(()),
+            }
+        })
         .map_err(|m| CaseError::new(path, CaseErrorKind::InvalidInput, m));
     agree(comm, path, checked)?;
     check_output(comm, path, None)?;
@@ -154,8 +175,8 @@ pub fn write_checkpoint(
     let gauss_rows = (gstart..gstart + gauss.len(), gtotal as usize);
 
     let ranks = comm.size() as u32;
-    let raw = total * datasets::bytes_per_particle()
-        + gtotal * (8 * (3 + GAUSS_LEN + NODE_LEN + CONTACT_LEN)) as u64
+    let raw = total * datasets::bytes_per_particle(width)
+        + gtotal * (8 * (3 + GAUSS_POINTS * width + NODE_LEN + CONTACT_LEN)) as u64
         + 8 * (header.tracked_gids.len() + header.rank_counts.len()) as u64;
     let text =
         (header.scene_toml.len() + header.scene_source.len() + header.code_version.len()) as u64;

@@ -26,7 +26,7 @@ pub const N_DOFS: usize = 2 * N_NODES;
 pub const N_GAUSS: usize = 3;
 
 /// Element contributions for one Newton iterate.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ElementOutput {
     /// f_int − f_body.
     pub residual: [f64; N_DOFS],
@@ -169,7 +169,7 @@ pub fn p2_element_with(
 ) -> Result<ElementOutput, ElementError> {
     let mut residual = [0.0; N_DOFS];
     let mut tangent = [[0.0; N_DOFS]; N_DOFS];
-    let mut states = *states_n;
+    let mut states = states_n.clone();
 
     for q in 0..N_GAUSS {
         let xi = area_to_reference(TRI3_POINTS[q]);
@@ -519,7 +519,7 @@ mod tests {
         let out = p2_element(
             &x,
             &[[0.0; 2]; 6],
-            &[GaussState::default(); 3],
+            &<[GaussState; 3]>::default(),
             &elastic(),
             b,
         )
@@ -633,7 +633,7 @@ mod tests {
         for e in &m.elems {
             let x: [[f64; 2]; 6] = std::array::from_fn(|a| m.nodes[e[a]]);
             let du: [[f64; 2]; 6] = std::array::from_fn(|a| u[e[a]]);
-            let out = p2_element(&x, &du, &[*st; 3], mat, [0.0; 2])?;
+            let out = p2_element(&x, &du, &std::array::from_fn(|_| st.clone()), mat, [0.0; 2])?;
             let dof = |l: usize| 2 * e[l / 2] + l % 2;
             for p in 0..N_DOFS {
                 r[dof(p)] += out.residual[p];

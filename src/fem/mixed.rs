@@ -59,6 +59,7 @@
 use crate::fem::element::{displacement_gradient, green_lagrange, ElementError, N_GAUSS};
 use crate::fem::p2::{self, N_NODES};
 use crate::fem::quadrature::{area_to_reference, TRI3_POINTS, TRI3_WEIGHTS};
+use crate::material::layout::for_each_strain;
 use crate::material::{GaussState, Material, MaterialError};
 
 /// Displacement dofs per element (2 per P2 node).
@@ -71,7 +72,7 @@ pub const N_MIXED_DOFS: usize = N_U_DOFS + N_P_DOFS;
 type Mat2 = [[f64; 2]; 2];
 
 /// Element contributions for one Newton iterate of the mixed element.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct MixedOutput {
     /// [momentum residual (12); volume residual (3)], see the module docs.
     pub residual: [f64; N_MIXED_DOFS],
@@ -283,7 +284,7 @@ pub fn p2p1_element(
     let inv_k = 1.0 / bulk;
     let mut residual = [0.0; N_MIXED_DOFS];
     let mut tangent = [[0.0; N_MIXED_DOFS]; N_MIXED_DOFS];
-    let mut states = *states_n;
+    let mut states = states_n.clone();
 
     for q in 0..N_GAUSS {
         let lp = TRI3_POINTS[q]; // P1 pressure shape functions = area coordinates
@@ -412,9 +413,13 @@ pub fn p2p1_element(
 
         let mut st = resp.state;
         st.stress = [sigma[0][0], sigma[1][1], s_dev[2] - p_h, sigma[0][1]];
-        let ep = &resp.state.plastic_strain;
-        let rep = rotate(r, &[[ep[0], 0.5 * ep[3]], [0.5 * ep[3], ep[1]]]);
-        st.plastic_strain = [rep[0][0], rep[1][1], ep[2], 2.0 * rep[0][1]];
+        // Strain-like internal variables were computed in the rotation-free frame, as the stress.
+        for_each_strain(mat.internal_variables(), &mut st.internal, |ep| {
+            let rep = rotate(r, &[[ep[0], 0.5 * ep[3]], [0.5 * ep[3], ep[1]]]);
+            ep[0] = rep[0][0];
+            ep[1] = rep[1][1];
+            ep[3] = 2.0 * rep[0][1];
+        });
         states[q] = st;
     }
 

@@ -14,45 +14,64 @@
 //! gradient, so that is the element's job, not the material's.
 
 pub mod elastic;
+pub mod layout;
 pub mod tresca;
+
+pub use layout::{InternalVar, Rows, StateLayout, VarKind, STRESS_LEN};
 
 use std::fmt;
 
-/// Per-Gauss-point history carried from one step to the next.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// Per-Gauss-point history carried from one step to the next: the stress, then the model's
+/// internal variables in the order of [`Material::internal_variables`].
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct GaussState {
     /// Cauchy stress `[xx, yy, zz, xy]` (tensor shear). On input to [`Material::update`] it is σ_n,
     /// the stress at the start of the step; the element overwrites it with σ_{n+1}.
     pub stress: [f64; 4],
-    /// Accumulated plastic strain `[xx, yy, zz, xy]` (engineering shear); zero for elastic models.
-    pub plastic_strain: [f64; 4],
-    /// Equivalent (accumulated) plastic strain; zero for elastic models.
-    pub eps_q: f64,
+    /// The internal variables, as the model lays them out (empty for an elastic law).
+    pub internal: Internal,
 }
 
-impl GaussState {
-    /// Number of scalars in the flat representation used for storage and communication.
-    pub const LEN: usize = 9;
+/// Internal variables of one Gauss point. Inline up to the size of the models here, so that
+/// an element's Gauss states cost no allocation; a model with more spills to the heap.
+pub type Internal = smallvec::SmallVec<[f64; 8]>;
 
-    /// Flattens as `[stress(4), plastic_strain(4), eps_q]`.
-    pub fn to_array(&self) -> [f64; Self::LEN] {
-        let s = &self.stress;
-        let p = &self.plastic_strain;
-        [s[0], s[1], s[2], s[3], p[0], p[1], p[2], p[3], self.eps_q]
+impl GaussState {
+    /// A state with stress `stress` and `n` zero internal variables.
+    pub fn stressed(stress: [f64; 4], n: usize) -> GaussState {
+        GaussState {
+            stress,
+            internal: smallvec::smallvec![0.0; n],
+        }
     }
 
-    /// Inverse of [`GaussState::to_array`].
-    pub fn from_array(a: &[f64; Self::LEN]) -> Self {
-        Self {
-            stress: [a[0], a[1], a[2], a[3]],
-            plastic_strain: [a[4], a[5], a[6], a[7]],
-            eps_q: a[8],
+    /// Scalars in the flat row (stress and internal variables).
+    pub fn len(&self) -> usize {
+        STRESS_LEN + self.internal.len()
+    }
+
+    /// Never: the stress is always there.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Writes the flat row `[stress, internal]` into `out` (of length [`GaussState::len`]).
+    pub fn write_to(&self, out: &mut [f64]) {
+        out[..STRESS_LEN].copy_from_slice(&self.stress);
+        out[STRESS_LEN..].copy_from_slice(&self.internal);
+    }
+
+    /// Inverse of [`GaussState::write_to`].
+    pub fn from_row(row: &[f64]) -> GaussState {
+        GaussState {
+            stress: [row[0], row[1], row[2], row[3]],
+            internal: Internal::from_slice(&row[STRESS_LEN..]),
         }
     }
 }
 
 /// Result of a constitutive update at one Gauss point.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct MaterialResponse {
     /// Second Piola–Kirchhoff stress relative to x_n, `[xx, yy, zz, xy]` (tensor shear).
     pub s: [f64; 4],
@@ -153,6 +172,28 @@ pub trait Material: Send + Sync + fmt::Debug {
 
     /// Short identifier used in logs and input files.
     fn name(&self) -> &'static str;
+
+    /// The internal variables the model keeps at a Gauss point, after the stress, in the order
+    /// of [`GaussState::internal`]. Storage, exchange, checkpoints and output follow it.
+    fn internal_variables(&self) -> &[InternalVar] {
+        &[]
+    }
+
+    /// The layout of this model's state rows.
+    fn layout(&self) -> StateLayout {
+        StateLayout::new(self.internal_variables())
+    }
+
+    /// Whether the model can yield at all (Newton then backtracks, and the iterative path
+    /// watches a yielded zone).
+    fn yields(&self) -> bool {
+        false
+    }
+
+    /// Whether a Gauss point yielded in going from `before` to `after`.
+    fn yielded(&self, _before: &GaussState, _after: &GaussState) -> bool {
+        false
+    }
 }
 
 #[cfg(test)]
@@ -160,16 +201,15 @@ mod tests {
     use super::*;
 
     #[test]
-    fn gauss_state_array_round_trip() {
+    fn gauss_state_row_round_trip() {
         let s = GaussState {
             stress: [1.0, -2.0, 3.5, 0.25],
-            plastic_strain: [1e-3, -2e-3, 0.0, 4e-3],
-            eps_q: 7.0e-3,
+            internal: Internal::from_slice(&[1e-3, -2e-3, 0.0, 4e-3, 7.0e-3]),
         };
-        let a = s.to_array();
-        assert_eq!(a.len(), GaussState::LEN);
+        let mut a = [0.0; 9];
+        s.write_to(&mut a);
         assert_eq!(a, [1.0, -2.0, 3.5, 0.25, 1e-3, -2e-3, 0.0, 4e-3, 7.0e-3]);
-        assert_eq!(GaussState::from_array(&a), s);
+        assert_eq!(GaussState::from_row(&a), s);
     }
 
     #[test]

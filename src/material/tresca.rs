@@ -44,7 +44,18 @@
 //! Cauchy stress), and the end-of-step Cauchy stress is on the yield surface to round-off.
 
 use super::elastic::LinearElastic;
-use super::{GaussState, Material, MaterialError, MaterialResponse};
+use super::{GaussState, InternalVar, Material, MaterialError, MaterialResponse};
+
+/// The internal variables: the accumulated plastic strain (engineering shear) and its
+/// equivalent `eps_q` (see the module docs).
+pub static VARIABLES: [InternalVar; 2] = [
+    InternalVar::strain("plastic_strain"),
+    InternalVar::scalar("eps_q"),
+];
+/// Offset of the plastic strain in [`GaussState::internal`].
+pub const PLASTIC_STRAIN: usize = 0;
+/// Offset of `eps_q` in [`GaussState::internal`].
+pub const EPS_Q: usize = 4;
 
 /// Elastic–perfectly plastic undrained clay (plane-strain Tresca); see the module docs.
 ///
@@ -154,7 +165,11 @@ impl Material for Tresca {
         let a = 0.5 * (s[0] - s[1]);
         let tau = s[3];
         let r = a.hypot(tau);
-        let mut state = *state_n;
+        let mut state = state_n.clone();
+        if state.internal.len() != EPS_Q + 1 {
+            // A fresh point (no internal variables yet) starts them at zero.
+            state.internal.resize(EPS_Q + 1, 0.0);
+        }
 
         // Strict comparison: a returned state has r = cu to round-off, so a tolerance would only
         // let round-off excursions above cu survive.
@@ -171,10 +186,11 @@ impl Material for Tresca {
 
         // Δε^p = Δλ ∂f/∂σ = Δλ/(2r) (a, −a, 0, τ) as a tensor; engineering shear doubles τ.
         let c = dlambda / (2.0 * r);
-        state.plastic_strain[0] += c * a;
-        state.plastic_strain[1] -= c * a;
-        state.plastic_strain[3] += 2.0 * c * tau;
-        state.eps_q += dlambda / 3.0_f64.sqrt();
+        let ep = &mut state.internal[PLASTIC_STRAIN..PLASTIC_STRAIN + 4];
+        ep[0] += c * a;
+        ep[1] -= c * a;
+        ep[3] += 2.0 * c * tau;
+        state.internal[EPS_Q] += dlambda / 3.0_f64.sqrt();
 
         // Unit in-plane deviator (Frobenius norm √(2a² + 2τ²) = √2 r).
         let nrm = std::f64::consts::SQRT_2 * r;
@@ -188,6 +204,19 @@ impl Material for Tresca {
 
     fn name(&self) -> &'static str {
         "tresca"
+    }
+
+    fn internal_variables(&self) -> &[InternalVar] {
+        &VARIABLES
+    }
+
+    fn yields(&self) -> bool {
+        true
+    }
+
+    fn yielded(&self, before: &GaussState, after: &GaussState) -> bool {
+        let q = |s: &GaussState| s.internal.get(EPS_Q).copied().unwrap_or(0.0);
+        q(after) > q(before)
     }
 }
 
@@ -220,7 +249,7 @@ mod tests {
             let r = m.update(&cur, de).expect("finite strain");
             cur = r.state;
             cur.stress = r.s;
-            out.push(cur);
+            out.push(cur.clone());
         }
         out
     }
@@ -277,8 +306,8 @@ mod tests {
                 );
             }
         }
-        assert_eq!(a.state.plastic_strain, [0.0; 4]);
-        assert_eq!(a.state.eps_q, 0.0);
+        assert_eq!(a.state.internal[..4], [0.0; 4]);
+        assert_eq!(a.state.internal[EPS_Q], 0.0);
     }
 
     #[test]
@@ -296,12 +325,12 @@ mod tests {
             );
             assert_eq!(st.stress[..3], [0.0; 3], "inc {k}");
             let gp = (gamma - CU / g).max(0.0);
-            assert!((st.plastic_strain[3] - gp).abs() < 1e-12 * gamma, "inc {k}");
+            assert!((st.internal[3] - gp).abs() < 1e-12 * gamma, "inc {k}");
             assert!(
-                (st.eps_q - gp / 3.0_f64.sqrt()).abs() < 1e-12 * gamma,
+                (st.internal[EPS_Q] - gp / 3.0_f64.sqrt()).abs() < 1e-12 * gamma,
                 "inc {k}"
             );
-            assert_eq!(st.plastic_strain[..3], [0.0; 3]);
+            assert_eq!(st.internal[..3], [0.0; 3]);
         }
         assert!((states[39].stress[3] - CU).abs() <= 2.0 * f64::EPSILON * CU);
     }
@@ -329,7 +358,7 @@ mod tests {
                 "σzz stays the mean stress"
             );
         }
-        assert!(states.iter().filter(|s| s.eps_q > 0.0).count() > 20);
+        assert!(states.iter().filter(|s| s.internal[EPS_Q] > 0.0).count() > 20);
     }
 
     #[test]
@@ -352,7 +381,7 @@ mod tests {
             }
             assert!(r.s[0].abs() <= 1e-12 * CU, "inc {inc}: σxx = {}", r.s[0]);
             let diff = r.s[0] - r.s[1];
-            if r.state.eps_q > st.eps_q {
+            if m.yielded(&st, &r.state) {
                 plastic_incs += 1;
                 assert!((diff - 2.0 * CU).abs() <= 1e-12 * CU, "inc {inc}: {diff}");
                 assert!(
@@ -368,7 +397,7 @@ mod tests {
             st.stress = r.s;
         }
         assert!(plastic_incs > 25, "{plastic_incs}");
-        let p = st.plastic_strain;
+        let p = &st.internal[..4];
         assert!(
             (p[0] + p[1] + p[2]).abs() < 1e-15,
             "plastic flow is isochoric"
@@ -385,12 +414,12 @@ mod tests {
         incs.extend(vec![[0.0, 0.0, 0.0, -dg]; 10]); // unload elastically, then reverse yield
         let states = drive(&m, GaussState::default(), &incs);
         let gp_fwd = 6.0 * dg - CU / g;
-        assert!((states[5].plastic_strain[3] - gp_fwd).abs() < 1e-12);
+        assert!((states[5].internal[3] - gp_fwd).abs() < 1e-12);
         for k in 6..12 {
             let want = CU - g * dg * (k - 5) as f64;
             assert!((states[k].stress[3] - want).abs() < 1e-9 * CU, "inc {k}");
-            assert_eq!(states[k].plastic_strain, states[5].plastic_strain);
-            assert_eq!(states[k].eps_q, states[5].eps_q);
+            assert_eq!(states[k].internal[..4], states[5].internal[..4]);
+            assert_eq!(states[k].internal[EPS_Q], states[5].internal[EPS_Q]);
         }
         for k in 12..16 {
             assert!(
@@ -399,10 +428,10 @@ mod tests {
             );
         }
         let gp_rev = 10.0 * dg - 2.0 * CU / g;
-        assert!((states[15].plastic_strain[3] - (gp_fwd - gp_rev)).abs() < 1e-12);
+        assert!((states[15].internal[3] - (gp_fwd - gp_rev)).abs() < 1e-12);
         // Accumulated equivalent strain counts both branches.
         let want_q = (gp_fwd + gp_rev) / 3.0_f64.sqrt();
-        assert!((states[15].eps_q - want_q).abs() < 1e-12);
+        assert!((states[15].internal[EPS_Q] - want_q).abs() < 1e-12);
     }
 
     #[test]
@@ -410,15 +439,15 @@ mod tests {
         let m = clay();
         let de = [4e-4, -3e-4, 0.0, 5e-4];
         let states = drive(&m, GaussState::default(), &[de; 30]);
-        let st = states[29];
-        assert!(st.eps_q > 1e-3, "must be well into plastic flow");
-        let p = st.plastic_strain;
+        let st = &states[29];
+        assert!(st.internal[EPS_Q] > 1e-3, "must be well into plastic flow");
+        let p = &st.internal[..4];
         let tensor_sq = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + 0.5 * p[3] * p[3];
         let eq = (2.0 / 3.0 * tensor_sq).sqrt();
         assert!(
-            (eq - st.eps_q).abs() < 1e-10 * st.eps_q,
+            (eq - st.internal[EPS_Q]).abs() < 1e-10 * st.internal[EPS_Q],
             "{eq} vs {}",
-            st.eps_q
+            st.internal[EPS_Q]
         );
     }
 
@@ -459,7 +488,7 @@ mod tests {
             [1e-3, 1e-3, 0.0, 6.0 * CU / g], // with a volumetric part
         ] {
             let r = m.update(&pre, &e).expect("ok");
-            assert!(r.state.eps_q > 0.0, "must be plastic: {e:?}");
+            assert!(r.state.internal[EPS_Q] > 0.0, "must be plastic: {e:?}");
             let rel = fd_check(&m, &pre, &e);
             assert!(rel < 1e-6, "plastic {e:?}: {rel:e}");
             for i in 0..4 {

@@ -11,18 +11,21 @@ use std::borrow::Cow;
 #[derive(Debug, Clone, PartialEq)]
 pub enum Field<'a> {
     /// A scalar.
-    Scalar(&'static str, Vec<f64>),
+    Scalar(Name, Vec<f64>),
     /// An in-plane vector `[x, y]`, written with z = 0 (see [`crate::output`] for why).
-    Vector(&'static str, Vec<[f64; 2]>),
+    Vector(Name, Vec<[f64; 2]>),
     /// A symmetric plane-strain tensor in Voigt order `[xx, yy, zz, xy]` with the TENSOR xy
     /// component (halve an engineering shear strain before passing it), written as the full
     /// 3 x 3 tensor.
-    Tensor(&'static str, Vec<[f64; 4]>),
+    Tensor(Name, Vec<[f64; 4]>),
     /// A borrowed [`Field::Scalar`].
-    ScalarRef(&'static str, &'a [f64]),
+    ScalarRef(Name, &'a [f64]),
     /// A borrowed [`Field::Vector`].
-    VectorRef(&'static str, &'a [[f64; 2]]),
+    VectorRef(Name, &'a [[f64; 2]]),
 }
+
+/// A field's name: a literal for the fixed fields, owned for those a material's layout names.
+pub type Name = Cow<'static, str>;
 
 /// What a field holds, which fixes its components on disk and its XDMF attribute type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -59,7 +62,7 @@ impl Kind {
 /// Name and kind of a field: all the series file needs to know about it.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct FieldDesc {
-    pub name: &'static str,
+    pub name: Name,
     pub kind: Kind,
 }
 
@@ -68,7 +71,7 @@ pub(crate) const GID: &str = "gid";
 
 impl Field<'_> {
     /// The field's name.
-    pub fn name(&self) -> &'static str {
+    pub fn name(&self) -> &str {
         match self {
             Field::Scalar(n, _)
             | Field::Vector(n, _)
@@ -104,7 +107,7 @@ impl Field<'_> {
 
     pub(crate) fn desc(&self) -> FieldDesc {
         FieldDesc {
-            name: self.name(),
+            name: Name::Owned(self.name().to_string()),
             kind: self.kind(),
         }
     }
@@ -177,45 +180,48 @@ mod tests {
 
     #[test]
     fn vectors_are_padded_and_tensors_expanded() {
-        let v = Field::Vector("u", vec![[1.0, 2.0], [3.0, 4.0]]);
+        let v = Field::Vector("u".into(), vec![[1.0, 2.0], [3.0, 4.0]]);
         assert_eq!(&*v.stored(), &[1.0, 2.0, 0.0, 3.0, 4.0, 0.0]);
-        let t = Field::Tensor("s", vec![[1.0, 2.0, 3.0, 4.0]]);
+        let t = Field::Tensor("s".into(), vec![[1.0, 2.0, 3.0, 4.0]]);
         assert_eq!(&*t.stored(), &[1.0, 4.0, 0.0, 4.0, 2.0, 0.0, 0.0, 0.0, 3.0]);
         let s = [5.0, 6.0];
-        assert_eq!(&*Field::ScalarRef("p", &s).stored(), &s);
+        assert_eq!(&*Field::ScalarRef("p".into(), &s).stored(), &s);
         assert_eq!(t.kind().components(), 9);
     }
 
     #[test]
     fn bad_names_and_lengths_are_rejected() {
         let ok = [
-            Field::Scalar("p", vec![0.0]),
-            Field::Vector("u-1", vec![[0.0; 2]]),
+            Field::Scalar("p".into(), vec![0.0]),
+            Field::Vector("u-1".into(), vec![[0.0; 2]]),
         ];
         assert!(check_fields(&ok, 1).is_ok());
         let e = check_fields(&ok, 2).unwrap_err();
         assert!(e.contains("\"p\" has 1 values for 2"), "{e}");
         for bad in ["", "a/b", "a:b", "a b", "é"] {
             assert!(
-                check_fields(&[Field::Scalar(bad, vec![])], 0).is_err(),
+                check_fields(&[Field::Scalar(bad.into(), vec![])], 0).is_err(),
                 "{bad}"
             );
         }
-        assert!(check_fields(&[Field::Scalar("gid", vec![])], 0).is_err());
-        let twice = [Field::Scalar("p", vec![]), Field::ScalarRef("p", &[])];
+        assert!(check_fields(&[Field::Scalar("gid".into(), vec![])], 0).is_err());
+        let twice = [
+            Field::Scalar("p".into(), vec![]),
+            Field::ScalarRef("p".into(), &[]),
+        ];
         assert!(check_fields(&twice, 0).unwrap_err().contains("twice"));
     }
 
     #[test]
     fn signature_tells_kinds_and_names_apart() {
-        let a = [Field::Scalar("p", vec![]).desc()];
-        let b = [Field::VectorRef("p", &[]).desc()];
-        let c = [Field::Scalar("q", vec![]).desc()];
+        let a = [Field::Scalar("p".into(), vec![]).desc()];
+        let b = [Field::VectorRef("p".into(), &[]).desc()];
+        let c = [Field::Scalar("q".into(), vec![]).desc()];
         assert_ne!(signature(&a), signature(&b));
         assert_ne!(signature(&a), signature(&c));
         assert_eq!(
             signature(&a),
-            signature(&[Field::ScalarRef("p", &[]).desc()])
+            signature(&[Field::ScalarRef("p".into(), &[]).desc()])
         );
     }
 }

@@ -253,7 +253,7 @@ mod tests {
             time,
             gid,
             position,
-            point_data: vec![Field::Scalar("p", vec![0.0; gid.len()])],
+            point_data: vec![Field::Scalar("p".into(), vec![0.0; gid.len()])],
             triangles: &[],
             owner_of: &|_| None,
         }

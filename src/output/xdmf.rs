@@ -86,7 +86,7 @@ pub(crate) fn frame_entry(f: &FrameInfo<'_>) -> FrameEntry {
     data_item(&mut x, &format!("{n} 2"), "Float", &file, "geometry");
     x.push_str("        </Geometry>\n");
     for d in f.fields {
-        attribute(&mut x, d.name, d.kind, n, "Float", &file);
+        attribute(&mut x, &d.name, d.kind, n, "Float", &file);
     }
     // Last, so that readers make the caller's first scalar field, not the ids, the active one.
     attribute(&mut x, GID, Kind::Scalar, n, "Int", &file);
@@ -163,15 +163,15 @@ mod tests {
     fn entry(step: u64, time: f64) -> FrameEntry {
         let fields = [
             FieldDesc {
-                name: "p",
+                name: "p".into(),
                 kind: Kind::Scalar,
             },
             FieldDesc {
-                name: "u",
+                name: "u".into(),
                 kind: Kind::Vector,
             },
             FieldDesc {
-                name: "s",
+                name: "s".into(),
                 kind: Kind::Tensor,
             },
         ];

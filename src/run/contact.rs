@@ -153,8 +153,7 @@ impl Simulation {
                         return [0.0; 2];
                     }
                     let sigma = |p: usize| {
-                        let s =
-                            self.point_value(mesh, p, &self.particles.state, &self.ghosts.state);
+                        let s = self.point_state(mesh, p);
                         [s[0], s[1], s[3]]
                     };
                     let (sa, sb) = (sigma(points[0]), sigma(points[1]));

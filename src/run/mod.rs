@@ -84,6 +84,7 @@ fn drive(
     // The per-rank table after the end-of-run line: sizes of the last mesh, CPU of the solves.
     let mut sizes = None;
     let mut solve_cpu = 0.0;
+    let mut collapse = None;
     while sim.step() < last {
         let mut t = PhaseTimer::default();
         let next = sim.step() + 1;
@@ -100,13 +101,18 @@ fn drive(
         })?;
         solve_cpu += rank_table::cpu_seconds() - cpu;
         sanity::check_step(world, sim, &mesh, &report)?;
-        if stop.requested(world) {
+        // A collapse in the first piece of a step leaves the step count: its row is the last.
+        let advanced = sim.step() == next;
+        if stop.requested(world) || report.collapse.is_some() {
             last = sim.step();
+            collapse = collapse.or(report.collapse);
         }
         t.time("output", || {
             fault("output", next)?;
-            out.record(world, sim)
-                .and_then(|_| out.fields_if_due(world, sim, &mesh, last))
+            if advanced {
+                out.record(world, sim)?;
+            }
+            out.fields_if_due(world, sim, &mesh, last)
         })?;
         t.time("checkpoint", || {
             fault("checkpoint", next)?;
@@ -130,5 +136,6 @@ fn drive(
     if let Some(sizes) = &sizes {
         rank_table::print(world, sizes, solve_cpu);
     }
-    out.plot(world)
+    out.plot(world)?;
+    sanity::check_collapse(world, sim, collapse, opts.until_step)
 }

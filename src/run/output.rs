@@ -3,6 +3,7 @@
 use super::error::agree;
 use super::{RunError, Simulation};
 use crate::history::{self, HistoryFile};
+use crate::material::{StateLayout, VarKind};
 use crate::mesh::LocalMesh;
 use crate::output::{Field, FieldsWriter, Frame};
 use mpi::traits::Communicator;
@@ -91,7 +92,7 @@ impl Output {
             return Ok(());
         }
         let p = &sim.particles;
-        let col = |k: usize| p.state.iter().map(|s| s[k]).collect::<Vec<f64>>();
+        let layout = sim.model.layout();
         let triangles: Vec<[u64; 3]> = (0..mesh.tris.len())
             .filter(|&t| mesh.tri_owned[t])
             .map(|t| mesh.tri_key(t))
@@ -109,22 +110,7 @@ impl Output {
             time: sim.load_factor(),
             gid: &p.gid,
             position: &p.position,
-            point_data: vec![
-                Field::VectorRef("displacement", &p.displacement),
-                Field::VectorRef("incremental_displacement", &p.increment),
-                Field::Scalar("eps_q", col(8)),
-                Field::Scalar("sigma_xx", col(0)),
-                Field::Scalar("sigma_yy", col(1)),
-                Field::Scalar("tau_xy", col(3)),
-                Field::Scalar(
-                    "pressure",
-                    p.state
-                        .iter()
-                        .map(|s| -(s[0] + s[1] + s[2]) / 3.0)
-                        .collect(),
-                ),
-                Field::Scalar("rank", vec![world.rank() as f64; p.len()]),
-            ],
+            point_data: point_data(world, p, &layout),
             triangles: &triangles,
             owner_of: &owner_of,
         };
@@ -198,4 +184,48 @@ fn prune_checkpoints(dir: &Path, keep: usize) {
     for p in names.into_iter().take(n.saturating_sub(keep.max(1))) {
         let _ = std::fs::remove_file(p);
     }
+}
+
+/// The fields of a frame: displacements, the stress as the plots read it, then one field per
+/// internal variable of the material's layout, by its name (a strain tensor as a tensor field).
+/// `eps_q` is written for every law, zero for one that does not yield, so that every run has the
+/// accumulated-plastic-strain picture.
+fn point_data<'a>(
+    world: &Comm,
+    p: &'a crate::particles::Particles,
+    layout: &StateLayout,
+) -> Vec<Field<'a>> {
+    let col = |k: usize| p.state.iter().map(|s| s[k]).collect::<Vec<f64>>();
+    let mut out = vec![
+        Field::VectorRef("displacement".into(), &p.displacement),
+        Field::VectorRef("incremental_displacement".into(), &p.increment),
+        Field::Scalar("sigma_xx".into(), col(0)),
+        Field::Scalar("sigma_yy".into(), col(1)),
+        Field::Scalar("tau_xy".into(), col(3)),
+        Field::Scalar(
+            "pressure".into(),
+            p.state
+                .iter()
+                .map(|s| -(s[0] + s[1] + s[2]) / 3.0)
+                .collect(),
+        ),
+        Field::Scalar("rank".into(), vec![world.rank() as f64; p.len()]),
+    ];
+    if layout.find("eps_q").is_none() {
+        out.push(Field::Scalar("eps_q".into(), vec![0.0; p.len()]));
+    }
+    for v in layout.vars() {
+        let (at, kind) = layout.find(&v.name).expect("a declared variable");
+        out.push(match kind {
+            VarKind::Scalar => Field::Scalar(v.name.clone(), col(at)),
+            VarKind::Strain => Field::Tensor(
+                v.name.clone(),
+                p.state
+                    .iter()
+                    .map(|s| [s[at], s[at + 1], s[at + 2], 0.5 * s[at + 3]])
+                    .collect(),
+            ),
+        });
+    }
+    out
 }

@@ -3,14 +3,11 @@
 
 use super::Simulation;
 use crate::fem::recovery::{barycentric, interpolate_linear};
-use crate::material::GaussState;
 use crate::mesh::refine::{deep_chords, plan, RefineParams};
 use crate::mesh::LocalMesh;
 use crate::particles::flag;
 use pfem_partition::{allgather_u64, sum_f64, Comm};
 use std::collections::HashSet;
-
-const K: usize = GaussState::LEN;
 
 /// A boundary particle this close to a rigid body (in its spacing) slides on it.
 const SLIDING_GAP: f64 = 0.1;
@@ -100,9 +97,9 @@ impl Simulation {
         let n = mesh.n_owned;
         let value = |p: usize| {
             if p < n {
-                self.particles.state[p]
+                self.particles.state.row(p)
             } else {
-                self.ghosts.state[p - n]
+                self.ghosts.state.row(p - n)
             }
         };
         let disp = |p: usize| {
@@ -152,7 +149,7 @@ impl Simulation {
                 return Err(super::RunError::Refinement { edge: key });
             };
             let (sa, sb) = (value(a), value(b));
-            let state: [f64; K] = std::array::from_fn(|k| 0.5 * (sa[k] + sb[k]));
+            let state: Vec<f64> = sa.iter().zip(sb).map(|(x, y)| 0.5 * (x + y)).collect();
             let (mut x, mut u) = (mid(mesh.points[a], mesh.points[b]), mid(disp(a), disp(b)));
             // A boundary chord round a body's corner cuts into the body: its new particle goes
             // onto the body's surface, where the soil it stands for is, instead of starting
@@ -180,7 +177,7 @@ impl Simulation {
         for (i, target, state, u) in smoothed {
             p.position[i] = target;
             p.displacement[i] = u;
-            p.state[i] = state;
+            p.state.row_mut(i).copy_from_slice(&state);
         }
         for (gid, x, u, du, h, state) in born {
             p.gid.push(gid);
@@ -188,7 +185,7 @@ impl Simulation {
             p.displacement.push(u);
             p.increment.push(du);
             p.h.push(h);
-            p.state.push(state);
+            p.state.push(&state);
             p.flags.push(0);
         }
         let removed: HashSet<u64> = plan.remove.iter().map(|&r| mesh.gids[r as usize]).collect();
@@ -199,7 +196,7 @@ impl Simulation {
             retain(&mut p.displacement, &keep);
             retain(&mut p.increment, &keep);
             retain(&mut p.h, &keep);
-            retain(&mut p.state, &keep);
+            p.state.retain(&keep);
             retain(&mut p.flags, &keep);
         }
         p.sort_by_gid();
@@ -217,18 +214,24 @@ fn retain<T: Copy>(v: &mut Vec<T>, keep: &[bool]) {
 }
 
 /// Linear interpolation of particle values at `target` inside a triangle around particle `p`.
-fn sample_star(
+fn sample_star<'a>(
     mesh: &LocalMesh,
     p: usize,
     target: [f64; 2],
-    value: &impl Fn(usize) -> [f64; K],
+    value: &impl Fn(usize) -> &'a [f64],
     disp: &impl Fn(usize) -> [f64; 2],
-) -> Option<([f64; K], [f64; 2])> {
+) -> Option<(Vec<f64>, [f64; 2])> {
     for t in mesh.tris.iter().filter(|t| t.contains(&(p as u32))) {
         let [a, b, c] = t.map(|v| v as usize);
         let bary = barycentric(mesh.points[a], mesh.points[b], mesh.points[c], target);
         if bary.iter().all(|&l| l.is_finite() && l >= -1e-12) {
-            let state = interpolate_linear(bary, &[value(a), value(b), value(c)]);
+            let vals = [value(a), value(b), value(c)];
+            let mut state = vec![0.0; vals[0].len()];
+            for (l, v) in bary.iter().zip(vals) {
+                for (o, x) in state.iter_mut().zip(v) {
+                    *o += l * x;
+                }
+            }
             let u = interpolate_linear(bary, &[disp(a), disp(b), disp(c)]);
             return Some((state, u));
         }

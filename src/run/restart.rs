@@ -4,15 +4,13 @@
 
 use super::Simulation;
 use crate::case_file::{
-    write_checkpoint, GaussRecords, ParticleSet, CONTACT_LEN, GAUSS_LEN, NODE_LEN,
+    write_checkpoint, GaussRecords, ParticleSet, CONTACT_LEN, GAUSS_POINTS, NODE_LEN,
 };
 use crate::mapping::TriStates;
-use crate::material::GaussState;
+use crate::material::Rows;
 use crate::particles::flag;
 use mpi::traits::Communicator;
 use pfem_partition::{alltoallv, locate, Comm};
-
-const K: usize = GaussState::LEN;
 
 /// The node keys of a triangle `[a, b, c]`: its vertices, then the midside nodes of edges 01,
 /// 12, 20 (the order of `/gauss/nodes`).
@@ -55,18 +53,17 @@ impl Simulation {
     /// state, each triangle once: from the owner of its smallest-gid vertex. Rank-local.
     pub(super) fn gauss_records(&self) -> GaussRecords {
         let p = &self.particles;
-        let mut records = GaussRecords::default();
+        let mut records = GaussRecords {
+            state: Rows::new(self.gauss_width()),
+            ..GaussRecords::default()
+        };
         let last = self.last_nodes.borrow();
         let touching = self.last_contact.borrow();
         for (key, states) in self.tri_states.iter() {
             // Each triangle once: by the owner of its smallest-gid vertex.
             if p.gid.binary_search(&key[0]).is_ok() {
                 records.key.push(*key);
-                let mut flat = [0.0; GAUSS_LEN];
-                for (q, s) in states.iter().enumerate() {
-                    flat[q * K..(q + 1) * K].copy_from_slice(&s.to_array());
-                }
-                records.state.push(flat);
+                records.state.push(states);
                 let mut nodes = [f64::NAN; NODE_LEN];
                 for (k, node) in tri_node_keys(key).iter().enumerate() {
                     if let Some(v) = last.get(node) {
@@ -88,6 +85,12 @@ impl Simulation {
         records
     }
 
+    /// Values in a triangle's state row: its Gauss points' rows of the material's layout (the
+    /// same on every rank, whatever it holds).
+    fn gauss_width(&self) -> usize {
+        GAUSS_POINTS * self.model.layout().len()
+    }
+
     /// Collective. Sends each stored triangle (Gauss states and node values) to the owners of its
     /// vertices.
     pub(super) fn restore_gauss(&mut self, world: &Comm, records: GaussRecords) {
@@ -104,20 +107,21 @@ impl Simulation {
             dest.dedup();
             for r in dest {
                 send[r as usize].extend_from_slice(key);
-                send[r as usize].extend(records.state[t].iter().map(|x| x.to_bits()));
+                send[r as usize].extend(records.state.row(t).iter().map(|x| x.to_bits()));
                 send[r as usize].extend(records.nodes[t].iter().map(|x| x.to_bits()));
                 send[r as usize].extend(records.contact[t].iter().map(|x| x.to_bits()));
             }
         }
         let received = alltoallv(world, &send);
+        let gw = self.gauss_width();
         let chunks = || {
             received
                 .iter()
-                .flat_map(|r| r.chunks_exact(3 + GAUSS_LEN + NODE_LEN + CONTACT_LEN))
+                .flat_map(|r| r.chunks_exact(3 + gw + NODE_LEN + CONTACT_LEN))
         };
         let mut last = Vec::new();
         for c in chunks() {
-            let nodes = &c[3 + GAUSS_LEN..];
+            let nodes = &c[3 + gw..];
             for (k, node) in tri_node_keys(&[c[0], c[1], c[2]]).iter().enumerate() {
                 let v: [f64; 3] = std::array::from_fn(|i| f64::from_bits(nodes[3 * k + i]));
                 // A node's displacement is NaN only where it was not stored.
@@ -131,7 +135,7 @@ impl Simulation {
         let mut touching = self.last_contact.borrow_mut();
         touching.clear();
         for c in chunks() {
-            let contact = &c[3 + GAUSS_LEN + NODE_LEN..];
+            let contact = &c[3 + gw + NODE_LEN..];
             for (k, node) in tri_node_keys(&[c[0], c[1], c[2]]).iter().enumerate() {
                 let v: [f64; 3] = std::array::from_fn(|i| f64::from_bits(contact[3 * k + i]));
                 if !v[0].is_nan() {
@@ -140,18 +144,13 @@ impl Simulation {
             }
         }
         drop(touching);
-        let pairs = chunks()
-            .map(|c| {
-                let states = std::array::from_fn(|q| {
-                    let mut a = [0.0; K];
-                    for (k, x) in a.iter_mut().enumerate() {
-                        *x = f64::from_bits(c[3 + q * K + k]);
-                    }
-                    GaussState::from_array(&a)
-                });
-                ([c[0], c[1], c[2]], states)
-            })
-            .collect();
-        self.tri_states = TriStates::from_pairs(pairs);
+        let mut keys = Vec::new();
+        let mut states = Rows::new(gw);
+        for c in chunks() {
+            keys.push([c[0], c[1], c[2]]);
+            let row: Vec<f64> = c[3..3 + gw].iter().map(|&x| f64::from_bits(x)).collect();
+            states.push(&row);
+        }
+        self.tri_states = TriStates::from_pairs(keys, states);
     }
 }

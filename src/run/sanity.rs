@@ -6,6 +6,7 @@
 use super::{RunError, RunOptions, Simulation, StepReport};
 use crate::mesh::LocalMesh;
 use crate::scene::Scene;
+use mpi::traits::Communicator;
 use pfem_partition::{sum_f64, Comm};
 
 /// Smallest body area, as a fraction of the scene's, that a step may end with. Plastic flow
@@ -79,6 +80,44 @@ fn holds_in_a_triangle(mesh: &LocalMesh, gid: u64) -> bool {
 /// Collective. After a step solved on `mesh`: an error when the mesh had no triangle, when the
 /// body's area fell below [`MIN_AREA_RATIO`] of the scene's, or when a `[[point_load]]`'s
 /// particle was in no triangle (the load was not applied). The same verdict on every rank.
+/// Collective. Under `steps.until_collapse`, says where the collapse was bracketed; reaching
+/// the last step without one is an error (the load never got there).
+pub(super) fn check_collapse(
+    world: &Comm,
+    sim: &Simulation,
+    collapse: Option<[f64; 2]>,
+    until_step: Option<u64>,
+) -> Result<(), RunError> {
+    let steps = sim.scene().steps;
+    if !steps.until_collapse {
+        return Ok(());
+    }
+    match collapse {
+        Some([held, failed]) => {
+            if world.rank() == 0 {
+                println!(
+                    "collapse reached: equilibrium holds at load factor {held:.6} and fails by \
+                     {failed:.6} (steps.collapse_tolerance = {})",
+                    steps.collapse_tolerance
+                );
+            }
+            Ok(())
+        }
+        None if sim.step() >= sim.total_steps() && until_step.is_none_or(|u| u >= sim.step()) => {
+            Err(RunError::Sanity {
+                step: sim.step(),
+                what: format!(
+                    "steps.until_collapse: equilibrium held up to load factor {:.6}, the end \
+                     of the load; raise the load (gravity.g, the prescribed motion) so that \
+                     the body collapses",
+                    sim.load_factor()
+                ),
+            })
+        }
+        None => Ok(()),
+    }
+}
+
 pub(super) fn check_step(
     world: &Comm,
     sim: &Simulation,

@@ -4,7 +4,6 @@ use super::RunError;
 use crate::case_file::{read_checkpoint, CaseHeader};
 use crate::history::Measures;
 use crate::mapping::{map_states, StartStates, TriStates};
-use crate::material::GaussState;
 use crate::mesh::local::halo_width;
 use crate::mesh::LocalMesh;
 use crate::model::Model;
@@ -70,6 +69,9 @@ pub struct StepReport {
     pub penetration: f64,
     /// Seconds of the step spent on contact (part of the solve phase); 0 without bodies.
     pub contact_seconds: f64,
+    /// Under `steps.until_collapse`: the bracket `[held, failed]` on the collapse load factor
+    /// when equilibrium failed in this step (the run then ends).
+    pub collapse: Option<[f64; 2]>,
 }
 
 impl Simulation {
@@ -209,13 +211,8 @@ impl Simulation {
     /// 16 % of its memory peak from the second step on (the cantilever at h = 1/128, 1 rank:
     /// 880 MB at step 2 against 758 at step 1).
     pub fn map(&mut self, mesh: &LocalMesh) -> StartStates {
-        let at_points: Vec<[f64; GaussState::LEN]> = self
-            .particles
-            .state
-            .iter()
-            .chain(&self.ghosts.state)
-            .copied()
-            .collect();
+        let mut at_points = self.particles.state.clone();
+        at_points.append(&mut self.ghosts.state.clone());
         let mut old = std::mem::take(&mut self.tri_states);
         if self.model.scene.mesh.remap_all {
             old = TriStates::default();
@@ -224,7 +221,7 @@ impl Simulation {
         drop(old);
         self.remapped
             .set(self.remapped.get() + stats.interpolated_owned as u64);
-        StartStates::new(states, self.model.plastic())
+        StartStates::new(states)
     }
 
     pub(super) fn reference_position(&self, mesh: &LocalMesh, p: usize) -> [f64; 2] {
@@ -380,12 +377,13 @@ impl Simulation {
             &dest,
             &self.particles.gid,
             &self.particles.records(),
-            crate::particles::RECORD,
+            self.particles.record_len(),
             &flags,
             1,
         );
-        self.particles =
-            Particles::from_records(gid, &rec, fl.into_iter().map(|f| f as u32).collect());
+        let width = self.particles.state.width();
+        let flags = fl.into_iter().map(|f| f as u32).collect();
+        self.particles = Particles::from_records(gid, &rec, width, flags);
         self.restore_gauss(world, records);
         Ok(())
     }

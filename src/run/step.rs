@@ -3,7 +3,7 @@
 
 use super::{Simulation, StepReport};
 use crate::mapping::{recover_at_particles, StartStates, TriStates};
-use crate::material::GaussState;
+use crate::material::Rows;
 use crate::mesh::LocalMesh;
 use crate::petsc::linear::{p_multigrid_from_options, upper_triangle_smoother_from_options};
 use crate::petsc::{
@@ -130,7 +130,8 @@ pub struct Solved {
     du: Vec<[f64; 2]>,
     /// Pressure of every local node (NaN without a pressure unknown).
     pressure: Vec<f64>,
-    states: Vec<[GaussState; 3]>,
+    /// Per local triangle, its Gauss points' rows of the material's layout.
+    states: Rows,
     reaction: [f64; 2],
     /// Reaction on each `[[fixed]]`, then `[[prescribed]]` entry (named ones; others zero).
     set_reactions: Vec<[f64; 2]>,
@@ -150,7 +151,7 @@ pub struct Solved {
 struct Outcome {
     du: Vec<[f64; 2]>,
     pressure: Vec<f64>,
-    states: Vec<[GaussState; 3]>,
+    states: Rows,
     reaction: [f64; 2],
     set_reactions: Vec<[f64; 2]>,
     body_force: Vec<[f64; 2]>,
@@ -178,11 +179,20 @@ pub(super) fn edge_key(a: u64, b: u64) -> [u64; 2] {
 }
 
 /// Pressure (compression positive) of a particle state.
-fn pressure(state: &[f64; GaussState::LEN]) -> f64 {
+fn pressure(state: &[f64]) -> f64 {
     -(state[0] + state[1] + state[2]) / 3.0
 }
 
 impl Simulation {
+    /// The state row of mesh point `p` (owned or ghost).
+    pub(super) fn point_state(&self, mesh: &LocalMesh, p: usize) -> &[f64] {
+        if p < mesh.n_owned {
+            self.particles.state.row(p)
+        } else {
+            self.ghosts.state.row(p - mesh.n_owned)
+        }
+    }
+
     pub(super) fn point_value<T: Copy>(
         &self,
         mesh: &LocalMesh,
@@ -244,7 +254,7 @@ impl Simulation {
             material: self.model.material.as_ref(),
             kernel: self.model.kernel,
             states_n,
-            body_force: self.model.body_force,
+            body_force: self.model.body_force_at(to),
             constraints: &constraints,
             point_loads,
             contact: loads.pairs,
@@ -548,7 +558,7 @@ impl Simulation {
         let last = self.last_nodes.borrow();
         let inc =
             |p: usize| self.point_value(mesh, p, &self.particles.increment, &self.ghosts.increment);
-        let state = |p: usize| self.point_value(mesh, p, &self.particles.state, &self.ghosts.state);
+        let state = |p: usize| self.point_state(mesh, p);
         problem
             .initial_guess(x, |n| {
                 if let Some(v) = last.get(&node_key(mesh, dofs, n)) {
@@ -758,6 +768,17 @@ impl Simulation {
         } else {
             self.header.load_factor += solved.dlambda;
         }
+        Ok(StepReport {
+            newton_iterations: solved.newton_iterations,
+            linear_iterations: solved.linear_iterations,
+            residual_norm: solved.residual_norm,
+            ..self.last_report(world, mesh)
+        })
+    }
+
+    /// Collective. A report of the particles and triangles now, and the triangles remapped
+    /// since the last report; no solver figures.
+    fn last_report(&self, world: &Comm, mesh: &LocalMesh) -> StepReport {
         let counts = sum_f64(
             world,
             &[
@@ -766,18 +787,12 @@ impl Simulation {
                 self.remapped.take() as f64,
             ],
         );
-        Ok(StepReport {
-            newton_iterations: solved.newton_iterations,
-            linear_iterations: solved.linear_iterations,
-            cuts: 0,
-            residual_norm: solved.residual_norm,
+        StepReport {
             particles: counts[0] as u64,
             triangles: counts[1] as u64,
             remapped: counts[2] as u64,
-            augmentations: 0,
-            penetration: 0.0,
-            contact_seconds: 0.0,
-        })
+            ..StepReport::default()
+        }
     }
 }
 
@@ -810,6 +825,16 @@ impl Simulation {
         let mut piece = full;
         let mut states = states;
         let (mut cuts, mut newton, mut linear, mut remapped) = (0, 0, 0, 0);
+        let steps = self.model.scene.steps;
+        // Under `until_collapse` a failure is cut until it brackets the collapse load factor.
+        let may_cut = |cuts: usize, piece: f64| {
+            if steps.until_collapse {
+                piece > steps.collapse_tolerance
+            } else {
+                cuts < MAX_CUTS
+            }
+        };
+        let mut converged_pieces = false;
         loop {
             let to = if from + piece >= target - 1e-9 * full {
                 target
@@ -830,6 +855,7 @@ impl Simulation {
                     newton += report.newton_iterations;
                     linear += report.linear_iterations;
                     remapped += report.remapped;
+                    converged_pieces = true;
                     if completes {
                         report.newton_iterations = newton;
                         report.linear_iterations = linear;
@@ -847,10 +873,27 @@ impl Simulation {
                 Err(SolveError::Diverged(_)) if !self.alternate_search.get() => {
                     self.alternate_search.set(true);
                 }
-                Err(SolveError::Diverged(_)) if cuts < MAX_CUTS => {
+                Err(SolveError::Diverged(_)) if may_cut(cuts, piece) => {
                     self.alternate_search.set(false);
                     cuts += 1;
                     piece *= 0.5;
+                }
+                Err(SolveError::Diverged(_)) if steps.until_collapse => {
+                    // Equilibrium held at `from` and fails within one tolerance above it. The
+                    // pieces that converged make a (shorter) step whose row is the collapse's.
+                    if converged_pieces {
+                        self.header.step += 1;
+                    }
+                    return Ok(StepReport {
+                        newton_iterations: newton,
+                        linear_iterations: linear,
+                        remapped,
+                        cuts,
+                        augmentations: self.augmentations.take() as usize,
+                        contact_seconds: self.contact_seconds.take(),
+                        collapse: Some([from, to]),
+                        ..self.last_report(world, mesh)
+                    });
                 }
                 Err(SolveError::Diverged(message)) => {
                     return Err(super::RunError::Diverged {

@@ -80,11 +80,12 @@ pub fn particle_count(scene: &Scene) -> u64 {
 /// `h = mesh.h`, zero displacement, zero state and zero flags.
 pub fn generate_particles(scene: &Scene) -> ParticleSet {
     let h = scene.mesh.h;
+    let width = crate::model::state_layout(scene).len();
     let Some(first) = scene.body.rectangles.first() else {
-        return ParticleSet::default();
+        return ParticleSet::with_capacity(0, width);
     };
     let anchor = first.origin;
-    let mut set = ParticleSet::with_capacity(particle_count(scene) as usize);
+    let mut set = ParticleSet::with_capacity(particle_count(scene) as usize, width);
     for (j, spans) in rows(anchor, h, &scene.body.rectangles) {
         let y = anchor[1] + j as f64 * h;
         for span in spans {
@@ -163,7 +164,7 @@ fn carve_rigid(scene: &Scene, base: ParticleSet) -> ParticleSet {
     }
     points.extend(ring);
     points.sort_by(|a, b| a.0[1].total_cmp(&b.0[1]).then(a.0[0].total_cmp(&b.0[0])));
-    let mut set = ParticleSet::with_capacity(points.len());
+    let mut set = ParticleSet::with_capacity(points.len(), base.state.width());
     for (gid, (p, h)) in points.into_iter().enumerate() {
         set.push_new(gid as u64, p, h);
     }
@@ -215,7 +216,7 @@ fn refine_regions(scene: &Scene, base: ParticleSet) -> ParticleSet {
         }
     }
     points.sort_by(|a, b| a.0[1].total_cmp(&b.0[1]).then(a.0[0].total_cmp(&b.0[0])));
-    let mut set = ParticleSet::with_capacity(points.len());
+    let mut set = ParticleSet::with_capacity(points.len(), base.state.width());
     for (gid, (p, h)) in points.into_iter().enumerate() {
         set.push_new(gid as u64, p, h);
     }

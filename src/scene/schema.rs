@@ -236,6 +236,16 @@ pub struct Material {
 pub struct Gravity {
     #[serde(default)]
     pub g: [f64; 2],
+    /// Scale the body force with the load factor, from nothing at the start to `density * g`
+    /// at load factor 1, so that a slope or cut can be loaded by its own weight (to collapse
+    /// with `steps.until_collapse`). The body then starts unstressed: no `[geostatic]`. Default
+    /// false (the full weight from the first step, in equilibrium with `[geostatic]`).
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub ramp: bool,
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 /// A displacement component.
@@ -333,7 +343,7 @@ impl Selection {
 }
 
 /// `[steps]`: load stepping.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Steps {
     /// Number of load steps, >= 1; the load factor goes from 0 to 1 in equal increments. With
@@ -341,6 +351,38 @@ pub struct Steps {
     /// given, it must equal that total).
     #[serde(default)]
     pub count: u32,
+    /// Collapse is the expected end of the run (a slope or cut loaded by `gravity.ramp`, a
+    /// footing pushed by force): when Newton fails, the step is cut until the load factor of
+    /// collapse is bracketed within `collapse_tolerance`, the run reports the largest load
+    /// factor at which equilibrium held, and exits 0. Without it, a step that does not converge
+    /// is an error. Reaching the last step without collapse is an error too. Default false.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub until_collapse: bool,
+    /// Width of the bracket on the collapse load factor (in load-factor units, 0 < tolerance
+    /// < 1). Default 0.001.
+    #[serde(
+        default = "default_collapse_tolerance",
+        skip_serializing_if = "is_default_collapse_tolerance"
+    )]
+    pub collapse_tolerance: f64,
+}
+
+impl Default for Steps {
+    fn default() -> Steps {
+        Steps {
+            count: 0,
+            until_collapse: false,
+            collapse_tolerance: default_collapse_tolerance(),
+        }
+    }
+}
+
+fn default_collapse_tolerance() -> f64 {
+    1e-3
+}
+
+fn is_default_collapse_tolerance(t: &f64) -> bool {
+    *t == default_collapse_tolerance()
 }
 
 /// Which quantities `history.csv` records.

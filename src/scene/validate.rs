@@ -276,6 +276,21 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
             format!("must be >= 1 (got {})", s.steps.count),
         );
     }
+    let tol = s.steps.collapse_tolerance;
+    if !(tol > 0.0 && tol < 1.0) {
+        return fail(
+            root.join("steps").join("collapse_tolerance"),
+            format!("must be > 0 and < 1 (got {tol})"),
+        );
+    }
+    if s.gravity.ramp && s.geostatic.is_some() {
+        return fail(
+            root.join("gravity").join("ramp"),
+            "ramps the weight up from nothing, so the body starts unstressed; [geostatic] is the \
+             stress of the full weight: leave one of them out"
+                .to_string(),
+        );
+    }
 
     let kind = root.join("history").join("kind");
     match s.history.kind {

@@ -262,7 +262,7 @@ mod tests {
         let out = p2_element(
             &straight_sided(&x),
             &[[0.0; 2]; 6],
-            &[GaussState::default(); 3],
+            &<[GaussState; 3]>::default(),
             &m,
             [0.0, 0.0],
         )

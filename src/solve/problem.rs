@@ -11,7 +11,8 @@ use crate::fem::mixed::p2p1_element;
 use crate::fem::p2::straight_sided;
 use crate::fem::surface_load::edge_pressure;
 use crate::mapping::StartStates;
-use crate::material::{GaussState, Material};
+use crate::mapping::{push_states, POINTS};
+use crate::material::{GaussState, Material, Rows};
 use crate::mesh::LocalMesh;
 use crate::petsc::matrix::{to_int, MatRef};
 use crate::petsc::snes::{CallbackError, NonlinearProblem};
@@ -72,8 +73,9 @@ pub struct ElementResult {
 
 /// The converged increment ([`StepProblem::converged`]).
 pub struct Converged {
-    /// Per local triangle, the Gauss states at the end of the increment.
-    pub states: Vec<[GaussState; 3]>,
+    /// Per local triangle, the Gauss states at the end of the increment (its Gauss points' rows
+    /// of the material's layout).
+    pub states: Rows,
     /// (triangle, displacement residual) of the triangles with a prescribed owned dof.
     residuals: Vec<(usize, [f64; 12])>,
 }
@@ -330,12 +332,13 @@ impl<'a> StepProblem<'a> {
                 self.dofs.node_owned[node] && self.setup.constraints.is_fixed(node, k % 2)
             })
         };
+        let width = POINTS * self.setup.material.layout().len();
         let mut out = Converged {
-            states: Vec::with_capacity(self.n_triangles()),
+            states: Rows::with_capacity(width, self.n_triangles()),
             residuals: Vec::new(),
         };
         let mut take = |t: usize, e: &ElementResult| {
-            out.states.push(e.states);
+            push_states(&mut out.states, &e.states);
             if reacting(t) {
                 out.residuals
                     .push((t, std::array::from_fn(|k| e.residual[k])));
@@ -816,8 +819,12 @@ impl NonlinearProblem for StepProblem<'_> {
             if let Some(y) = yielded.as_mut() {
                 // Each triangle once over the ranks: its owner lists it.
                 let start = self.setup.states_n.get(t);
+                let material = self.setup.material;
                 if self.mesh.tri_owned[t]
-                    && e.states.iter().zip(&start).any(|(a, b)| a.eps_q > b.eps_q)
+                    && e.states
+                        .iter()
+                        .zip(&start)
+                        .any(|(a, b)| material.yielded(b, a))
                 {
                     for &n in &self.dofs.tri_nodes[t] {
                         let first = self.dofs.node_global[n as usize];

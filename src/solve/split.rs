@@ -124,7 +124,7 @@ mod tests {
         let (e, nu) = (12.0e6, 0.3);
         let g = e / (2.0 * (1.0 + nu));
         let mat = LinearElastic::new(e, nu).expect("material");
-        let states = [GaussState::default(); 3];
+        let states = <[GaussState; 3]>::default();
         let du = [[0.001, -0.002]; 6];
         let got = effective_shear_modulus(&triangle(), &du, &states, &mat).expect("valid");
         assert!((got - g).abs() < 1e-9 * g, "{got} vs {g}");
@@ -135,7 +135,7 @@ mod tests {
         let (e, nu, cu) = (10.0e6, 0.49, 10.0e3);
         let g = e / (2.0 * (1.0 + nu));
         let mat = Tresca::new(e, nu, cu).expect("material");
-        let states = [GaussState::default(); 3];
+        let states = <[GaussState; 3]>::default();
         // A simple shear well past yield: γ = 0.01 ≫ cu/G.
         let x = triangle();
         let du: [[f64; 2]; 6] = std::array::from_fn(|k| [0.01 * x[k][1], 0.0]);
