@@ -130,6 +130,12 @@ pub fn new_case(scene: &Scene, source: &str) -> (CaseHeader, ParticleSet) {
         .chain(scene.probe.iter().map(|p| p.at))
         .filter_map(|at| lattice::nearest(&particles, at).map(|(gid, _)| gid))
         .collect();
+    // A scene that fails here fails again, with its message, when the case is loaded.
+    if let Ok(material) = crate::model::material_of(scene) {
+        for (x, state) in particles.position.iter().zip(particles.state.iter_mut()) {
+            material.initial_internal(*x, &mut state[crate::material::STRESS_LEN..]);
+        }
+    }
     if let Some(g) = &scene.geostatic {
         let gamma = scene.material.density * scene.gravity.g[0].hypot(scene.gravity.g[1]);
         for (x, state) in particles.position.iter().zip(particles.state.iter_mut()) {

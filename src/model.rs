@@ -1,7 +1,7 @@
 //! What a scene means for the solver: material, element, supports, prescribed motion, loads.
 
 use crate::material::elastic::LinearElastic;
-use crate::material::tresca::Tresca;
+use crate::material::tresca::{CuProfile, Tresca};
 use crate::material::{Material, StateLayout};
 use crate::rigid::RigidBody;
 use crate::scene::{Axis, ElementChoice, MaterialModel, Prescribed, Scene, Selection};
@@ -13,8 +13,31 @@ use crate::solve::Kernel;
 pub fn state_layout(scene: &Scene) -> StateLayout {
     match scene.material.model {
         MaterialModel::LinearElastic => StateLayout::default(),
+        MaterialModel::Tresca if scene.material.cu_gradient != 0.0 => {
+            StateLayout::new(&crate::material::tresca::VARIABLES_WITH_CU)
+        }
         MaterialModel::Tresca => StateLayout::new(&crate::material::tresca::VARIABLES),
     }
+}
+
+/// The constitutive model of a scene, its parameters checked.
+pub fn material_of(scene: &Scene) -> Result<Box<dyn Material>, String> {
+    let m = &scene.material;
+    let named = |e: crate::material::MaterialError| format!("material: {e}");
+    Ok(match m.model {
+        MaterialModel::LinearElastic => {
+            Box::new(LinearElastic::new(m.young, m.poisson).map_err(named)?)
+        }
+        MaterialModel::Tresca => {
+            let t = Tresca::new(m.young, m.poisson, m.cu).map_err(named)?;
+            match (m.cu_gradient, m.reference_level) {
+                (k, Some(level)) if k != 0.0 => {
+                    Box::new(t.with_profile(CuProfile { gradient: k, level }))
+                }
+                _ => Box::new(t),
+            }
+        }
+    })
 }
 
 pub struct Model {
@@ -31,17 +54,9 @@ pub struct Model {
 impl Model {
     pub fn new(scene: &Scene) -> Result<Model, String> {
         let m = &scene.material;
-        let named = |e: crate::material::MaterialError| format!("material: {e}");
-        let (material, mixed_default): (Box<dyn Material>, bool) = match m.model {
-            MaterialModel::LinearElastic => (
-                Box::new(LinearElastic::new(m.young, m.poisson).map_err(named)?),
-                false,
-            ),
-            MaterialModel::Tresca => (
-                Box::new(Tresca::new(m.young, m.poisson, m.cu).map_err(named)?),
-                true,
-            ),
-        };
+        let material = material_of(scene)?;
+        // Incompressible plastic flow locks the displacement-only element.
+        let mixed_default = material.yields();
         let mixed = match scene.solver.element {
             ElementChoice::Auto => mixed_default,
             ElementChoice::P2 => false,

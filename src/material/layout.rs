@@ -87,7 +87,7 @@ impl StateLayout {
 
     /// Scalars after the stress.
     pub fn internal_len(&self) -> usize {
-        self.vars.iter().map(|v| v.kind.width()).sum()
+        internal_len(&self.vars)
     }
 
     pub fn vars(&self) -> &[InternalVar] {
@@ -117,6 +117,11 @@ impl StateLayout {
         }
         None
     }
+}
+
+/// Scalars that `vars` take in a row.
+pub fn internal_len(vars: &[InternalVar]) -> usize {
+    vars.iter().map(|v| v.kind.width()).sum()
 }
 
 /// Applies `f` to every strain-tensor variable of `internal` (laid out as `vars`).

@@ -179,6 +179,11 @@ pub trait Material: Send + Sync + fmt::Debug {
         &[]
     }
 
+    /// Sets the internal variables that a point takes from where it starts (a strength that
+    /// varies with depth), in `internal` laid out as [`Material::internal_variables`]. The
+    /// others start at zero.
+    fn initial_internal(&self, _x0: [f64; 2], _internal: &mut [f64]) {}
+
     /// The layout of this model's state rows.
     fn layout(&self) -> StateLayout {
         StateLayout::new(self.internal_variables())

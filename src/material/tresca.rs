@@ -44,6 +44,7 @@
 //! Cauchy stress), and the end-of-step Cauchy stress is on the yield surface to round-off.
 
 use super::elastic::LinearElastic;
+use super::layout::internal_len;
 use super::{GaussState, InternalVar, Material, MaterialError, MaterialResponse};
 
 /// The internal variables: the accumulated plastic strain (engineering shear) and its
@@ -56,6 +57,24 @@ pub static VARIABLES: [InternalVar; 2] = [
 pub const PLASTIC_STRAIN: usize = 0;
 /// Offset of `eps_q` in [`GaussState::internal`].
 pub const EPS_Q: usize = 4;
+/// With a strength profile, the point's own cu follows: fixed where its particle started, it
+/// travels with the state like any internal variable.
+pub static VARIABLES_WITH_CU: [InternalVar; 3] = [
+    InternalVar::strain("plastic_strain"),
+    InternalVar::scalar("eps_q"),
+    InternalVar::scalar("cu"),
+];
+/// Offset of the point's `cu` in [`GaussState::internal`] (with a profile).
+pub const CU: usize = 5;
+
+/// Strength growing linearly with depth below a level: cu(y) = cu + gradient (level - y).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CuProfile {
+    /// Pa/m.
+    pub gradient: f64,
+    /// m.
+    pub level: f64,
+}
 
 /// Elastic–perfectly plastic undrained clay (plane-strain Tresca); see the module docs.
 ///
@@ -67,8 +86,10 @@ pub struct Tresca {
     pub young: f64,
     /// Poisson's ratio ν, in (-1, 0.5); undrained clay uses 0.49–0.495.
     pub poisson: f64,
-    /// Undrained shear strength cu (Pa), > 0.
+    /// Undrained shear strength cu (Pa), > 0: everywhere, or at and above the profile's level.
     pub cu: f64,
+    /// Strength that varies with the initial depth of a point; None: uniform `cu`.
+    pub profile: Option<CuProfile>,
 }
 
 /// Deviatoric projector on Voigt vectors, engineering shear on the strain side (tensor shear
@@ -102,7 +123,29 @@ impl Tresca {
                 requirement: "0 < cu < inf",
             });
         }
-        Ok(Self { young, poisson, cu })
+        Ok(Self {
+            young,
+            poisson,
+            cu,
+            profile: None,
+        })
+    }
+
+    /// The same material with a strength profile: each point's cu is set from the height `y` it
+    /// starts at ([`Material::initial_internal`]) and kept in its state.
+    pub fn with_profile(self, profile: CuProfile) -> Self {
+        Self {
+            profile: Some(profile),
+            ..self
+        }
+    }
+
+    /// cu at initial height `y`.
+    pub fn cu_at(&self, y: f64) -> f64 {
+        match self.profile {
+            Some(p) => self.cu + p.gradient * (p.level - y).max(0.0),
+            None => self.cu,
+        }
     }
 
     /// Shear modulus G = E / (2(1 + ν)).
@@ -166,19 +209,24 @@ impl Material for Tresca {
         let tau = s[3];
         let r = a.hypot(tau);
         let mut state = state_n.clone();
-        if state.internal.len() != EPS_Q + 1 {
+        let len = internal_len(self.internal_variables());
+        if state.internal.len() != len {
             // A fresh point (no internal variables yet) starts them at zero.
-            state.internal.resize(EPS_Q + 1, 0.0);
+            state.internal.resize(len, 0.0);
         }
+        let cu = match self.profile {
+            Some(_) => state.internal[CU],
+            None => self.cu,
+        };
 
         // Strict comparison: a returned state has r = cu to round-off, so a tolerance would only
         // let round-off excursions above cu survive.
-        if r <= self.cu {
+        if r <= cu {
             return Ok(MaterialResponse { s, d: d_el, state });
         }
 
-        let beta = self.cu / r;
-        let dlambda = (r - self.cu) / self.shear_modulus();
+        let beta = cu / r;
+        let dlambda = (r - cu) / self.shear_modulus();
         let shrink = 1.0 - beta;
         s[0] -= shrink * a;
         s[1] += shrink * a;
@@ -207,7 +255,16 @@ impl Material for Tresca {
     }
 
     fn internal_variables(&self) -> &[InternalVar] {
-        &VARIABLES
+        match self.profile {
+            Some(_) => &VARIABLES_WITH_CU,
+            None => &VARIABLES,
+        }
+    }
+
+    fn initial_internal(&self, x0: [f64; 2], internal: &mut [f64]) {
+        if self.profile.is_some() {
+            internal[CU] = self.cu_at(x0[1]);
+        }
     }
 
     fn yields(&self) -> bool {

@@ -16,6 +16,7 @@ pub const BUILTINS: &[(&str, &str)] = &[
     ("tbar-smooth", include_str!("builtin/tbar-smooth.toml")),
     ("tbar-rough", include_str!("builtin/tbar-rough.toml")),
     ("pipeline", include_str!("builtin/pipeline.toml")),
+    ("vertical-cut", include_str!("builtin/vertical-cut.toml")),
 ];
 
 /// TOML text of the built-in scene `name`.

@@ -226,8 +226,22 @@ pub struct Material {
     #[serde(default)]
     pub density: f64,
     /// Undrained shear strength (Pa); required > 0 for `"tresca"`, ignored otherwise. Default 0.
+    /// With `cu_gradient` it is the strength at `reference_level` and above.
     #[serde(default)]
     pub cu: f64,
+    /// `"tresca"` only: strength growing with depth, cu(y) = cu + cu_gradient * (reference_level
+    /// - y) below `reference_level` (Pa/m; offshore clays: 1-2 kPa/m). Each particle keeps the
+    /// strength of its initial position as it moves (an internal variable `cu` in the state and
+    /// the output). Default 0 (uniform).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub cu_gradient: f64,
+    /// Level (m) below which `cu_gradient` applies; required with it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_level: Option<f64>,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// `[gravity]`: gravitational acceleration vector (m/s2), e.g. `g = [0.0, -9.81]`.

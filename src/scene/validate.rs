@@ -233,8 +233,22 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
                     format!("must be > 0 for model \"tresca\" (got {})", s.material.cu),
                 );
             }
+            cu_profile(s, &mat)?;
         }
-        MaterialModel::LinearElastic => non_negative(mat.join("cu"), s.material.cu)?,
+        MaterialModel::LinearElastic => {
+            non_negative(mat.join("cu"), s.material.cu)?;
+            if s.material.cu_gradient != 0.0 || s.material.reference_level.is_some() {
+                let key = if s.material.cu_gradient != 0.0 {
+                    "cu_gradient"
+                } else {
+                    "reference_level"
+                };
+                return fail(
+                    mat.join(key),
+                    "is a parameter of model \"tresca\", not of \"linear-elastic\"".to_string(),
+                );
+            }
+        }
     }
 
     finite2(root.join("gravity").join("g"), s.gravity.g)?;
@@ -446,4 +460,41 @@ pub fn validate(s: &Scene) -> Result<(), Invalid> {
     check_alignment(s)?;
     super::validate_fine::check(s)?;
     check_against_particles(s)
+}
+
+/// A Tresca strength profile: a finite gradient with its reference level, and cu > 0 down to the
+/// lowest point of the body.
+fn cu_profile(s: &Scene, mat: &FieldPath) -> Result<(), Invalid> {
+    let m = &s.material;
+    let k = m.cu_gradient;
+    if !k.is_finite() {
+        return fail(mat.join("cu_gradient"), format!("must be finite (got {k})"));
+    }
+    let Some(level) = m.reference_level else {
+        if k != 0.0 {
+            return fail(
+                mat.join("reference_level"),
+                "is required with cu_gradient: the level below which cu grows".to_string(),
+            );
+        }
+        return Ok(());
+    };
+    if !level.is_finite() {
+        return fail(
+            mat.join("reference_level"),
+            format!("must be finite (got {level})"),
+        );
+    }
+    let [[_, y_min], _] = s.bounding_box();
+    let lowest = m.cu + k * (level - y_min).max(0.0);
+    if !(lowest > 0.0) {
+        return fail(
+            mat.join("cu_gradient"),
+            format!(
+                "makes cu = {lowest} Pa at y = {y_min} m, the body's lowest point: cu must stay \
+                 > 0 everywhere"
+            ),
+        );
+    }
+    Ok(())
 }
