@@ -129,6 +129,7 @@ fn test_header(scene_toml: &str) -> CaseHeader {
         ranks: 0,
         tracked_gids: vec![1007, 1000 + 7 * 56, u64::MAX],
         rank_counts: Vec::new(),
+        collapse_reference: None,
         state_columns: ["stress_xx", "stress_yy", "stress_zz", "stress_xy"]
             .map(String::from)
             .to_vec(),

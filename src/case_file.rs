@@ -16,6 +16,7 @@
 //! | `next_gid` | u64 | first global id not yet used |
 //! | `ranks` | u32 | number of MPI ranks that wrote the file |
 //! | `tracked_gids` | u64 array | particle tracked by each `[[point_load]]`, in order |
+//! | `collapse_reference` | f64, optional | `steps.until_collapse`: the first increment's largest displacement per unit load factor |
 //!
 //! Datasets in group `/particles`, n = global particle count, one row per particle:
 //! `gid` (u64, n), `position` (f64, n x 2, current), `displacement` (f64, n x 2, total since the
@@ -116,6 +117,9 @@ pub struct CaseHeader {
     /// The name of each column of a state row (the scene's material's layout): what the `names`
     /// attribute of the state datasets holds. A read case has been conformed to its scene.
     pub state_columns: Vec<String>,
+    /// Under `steps.until_collapse`: the largest displacement per unit load factor of the first
+    /// increment, against which a mechanism is told (`steps.collapse_compliance`).
+    pub collapse_reference: Option<f64>,
 }
 
 /// A new case at step 0: the scene's particle lattice and, for each point load, the particle
@@ -158,6 +162,7 @@ pub fn new_case(scene: &Scene, source: &str) -> (CaseHeader, ParticleSet) {
         ranks: 1,
         tracked_gids,
         state_columns: crate::model::state_layout(scene).columns(),
+        collapse_reference: None,
         rank_counts: Vec::new(),
     };
     (header, particles)

@@ -36,6 +36,9 @@ pub fn write_header(file: &File, h: &CaseHeader, ranks: u32) -> hdf5::Result<()>
     put(file, "time", h.time)?;
     put(file, "next_gid", h.next_gid)?;
     put(file, "ranks", ranks)?;
+    if let Some(c) = h.collapse_reference {
+        put(file, "collapse_reference", c)?;
+    }
     file.new_attr::<u64>()
         .shape(h.tracked_gids.len())
         .create("tracked_gids")?
@@ -206,5 +209,15 @@ pub fn read_header(file: &File, path: &Path) -> Result<CaseHeader, CaseError> {
         },
         // Read from the state datasets' `names` attribute with the particles.
         state_columns: Vec::new(),
+        collapse_reference: if file
+            .attr_names()
+            .unwrap_or_default()
+            .iter()
+            .any(|n| n == "collapse_reference")
+        {
+            Some(r.scalar("collapse_reference")?)
+        } else {
+            None
+        },
     })
 }

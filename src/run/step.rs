@@ -567,7 +567,7 @@ impl Simulation {
                 let p = dofs.node_point[n];
                 if p != u32::MAX {
                     let (d, s) = (inc(p as usize), state(p as usize));
-                    [scale * d[0], scale * d[1], pressure(&s)]
+                    [scale * d[0], scale * d[1], pressure(s)]
                 } else {
                     let [a, b] = dofs.edges[n - (dofs.n_nodes() - dofs.edges.len())];
                     let (da, db) = (inc(a as usize), inc(b as usize));
@@ -847,6 +847,24 @@ impl Simulation {
             let solved = self.solve(world, petsc, mesh, &states, from, to);
             crate::heap::release_free_pages();
             match solved {
+                Ok(solved) if steps.until_collapse && self.is_mechanism(world, &solved) => {
+                    self.alternate_search.set(false);
+                    newton += solved.newton_iterations;
+                    linear += solved.linear_iterations;
+                    if may_cut(cuts, piece) {
+                        cuts += 1;
+                        piece *= 0.5;
+                    } else {
+                        let counts = [newton, linear, cuts, remapped as usize];
+                        return Ok(self.collapsed(
+                            world,
+                            mesh,
+                            converged_pieces,
+                            [from, to],
+                            counts,
+                        ));
+                    }
+                }
                 Ok(solved) => {
                     self.alternate_search.set(false);
                     let completes = to == target;
@@ -879,21 +897,8 @@ impl Simulation {
                     piece *= 0.5;
                 }
                 Err(SolveError::Diverged(_)) if steps.until_collapse => {
-                    // Equilibrium held at `from` and fails within one tolerance above it. The
-                    // pieces that converged make a (shorter) step whose row is the collapse's.
-                    if converged_pieces {
-                        self.header.step += 1;
-                    }
-                    return Ok(StepReport {
-                        newton_iterations: newton,
-                        linear_iterations: linear,
-                        remapped,
-                        cuts,
-                        augmentations: self.augmentations.take() as usize,
-                        contact_seconds: self.contact_seconds.take(),
-                        collapse: Some([from, to]),
-                        ..self.last_report(world, mesh)
-                    });
+                    let counts = [newton, linear, cuts, remapped as usize];
+                    return Ok(self.collapsed(world, mesh, converged_pieces, [from, to], counts));
                 }
                 Err(SolveError::Diverged(message)) => {
                     return Err(super::RunError::Diverged {
@@ -906,6 +911,54 @@ impl Simulation {
                 }
                 Err(e) => return Err(super::RunError::Solve(e)),
             }
+        }
+    }
+}
+
+impl Simulation {
+    /// Collective. Whether a converged increment is a mechanism (`steps.collapse_compliance`):
+    /// its largest displacement per unit load factor against the first increment's, which the
+    /// first call records.
+    fn is_mechanism(&mut self, world: &Comm, solved: &Solved) -> bool {
+        let largest = solved
+            .du
+            .iter()
+            .map(|d| d[0].hypot(d[1]))
+            .fold(0.0, f64::max);
+        let compliance = max_f64(world, largest) / solved.dlambda;
+        match self.header.collapse_reference {
+            None => {
+                self.header.collapse_reference = Some(compliance);
+                false
+            }
+            Some(first) => compliance > self.model.scene.steps.collapse_compliance * first,
+        }
+    }
+
+    /// Collective. The report of a step in which the collapse was bracketed in `[held, failed]`:
+    /// equilibrium held at `held` (the body is there now) and failed, or was a mechanism, by
+    /// `failed`. Pieces of the step that converged make a (shorter) step whose row is the
+    /// collapse's. `counts`: Newton and linear iterations, cuts and remapped triangles so far.
+    fn collapsed(
+        &mut self,
+        world: &Comm,
+        mesh: &LocalMesh,
+        converged_pieces: bool,
+        bracket: [f64; 2],
+        counts: [usize; 4],
+    ) -> StepReport {
+        if converged_pieces {
+            self.header.step += 1;
+        }
+        StepReport {
+            newton_iterations: counts[0],
+            linear_iterations: counts[1],
+            cuts: counts[2],
+            remapped: counts[3] as u64,
+            augmentations: self.augmentations.take() as usize,
+            contact_seconds: self.contact_seconds.take(),
+            collapse: Some(bracket),
+            ..self.last_report(world, mesh)
         }
     }
 }

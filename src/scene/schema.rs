@@ -229,10 +229,10 @@ pub struct Material {
     /// With `cu_gradient` it is the strength at `reference_level` and above.
     #[serde(default)]
     pub cu: f64,
-    /// `"tresca"` only: strength growing with depth, cu(y) = cu + cu_gradient * (reference_level
-    /// - y) below `reference_level` (Pa/m; offshore clays: 1-2 kPa/m). Each particle keeps the
-    /// strength of its initial position as it moves (an internal variable `cu` in the state and
-    /// the output). Default 0 (uniform).
+    /// `"tresca"` only: strength growing with depth below `reference_level`, cu(y) = cu +
+    /// cu_gradient * (reference_level − y) (Pa/m; offshore clays: 1-2 kPa/m). Each particle
+    /// keeps the strength of its initial position as it moves (an internal variable `cu` in the
+    /// state and the output). Default 0 (uniform).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub cu_gradient: f64,
     /// Level (m) below which `cu_gradient` applies; required with it.
@@ -372,6 +372,17 @@ pub struct Steps {
     /// is an error. Reaching the last step without collapse is an error too. Default false.
     #[serde(default, skip_serializing_if = "is_false")]
     pub until_collapse: bool,
+    /// A load increment under which the body's largest displacement per unit load factor
+    /// exceeds this multiple of the first increment's (elastic) one is a mechanism: its
+    /// stiffness has fallen to 1/collapse_compliance of the initial. Collapse is the load factor
+    /// where that happens (or where equilibrium fails, if first): without this rule a large-
+    /// deformation run finds equilibrium again in the slumped shape (a cut flattens into a
+    /// stable slope) far above the collapse load of the body as drawn. Default 50.
+    #[serde(
+        default = "default_collapse_compliance",
+        skip_serializing_if = "is_default_collapse_compliance"
+    )]
+    pub collapse_compliance: f64,
     /// Width of the bracket on the collapse load factor (in load-factor units, 0 < tolerance
     /// < 1). Default 0.001.
     #[serde(
@@ -387,8 +398,17 @@ impl Default for Steps {
             count: 0,
             until_collapse: false,
             collapse_tolerance: default_collapse_tolerance(),
+            collapse_compliance: default_collapse_compliance(),
         }
     }
+}
+
+fn default_collapse_compliance() -> f64 {
+    50.0
+}
+
+fn is_default_collapse_compliance(c: &f64) -> bool {
+    *c == default_collapse_compliance()
 }
 
 fn default_collapse_tolerance() -> f64 {

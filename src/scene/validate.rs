@@ -297,6 +297,13 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
             format!("must be > 0 and < 1 (got {tol})"),
         );
     }
+    let c = s.steps.collapse_compliance;
+    if !(c > 1.0 && c.is_finite()) {
+        return fail(
+            root.join("steps").join("collapse_compliance"),
+            format!("must be > 1 and finite (got {c})"),
+        );
+    }
     if s.gravity.ramp && s.geostatic.is_some() {
         return fail(
             root.join("gravity").join("ramp"),
@@ -487,7 +494,7 @@ fn cu_profile(s: &Scene, mat: &FieldPath) -> Result<(), Invalid> {
     }
     let [[_, y_min], _] = s.bounding_box();
     let lowest = m.cu + k * (level - y_min).max(0.0);
-    if !(lowest > 0.0) {
+    if lowest.is_nan() || lowest <= 0.0 {
         return fail(
             mat.join("cu_gradient"),
             format!(
