@@ -35,13 +35,21 @@ pub enum ShapeError {
     /// vertex `k + 1`), or two adjacent edges fold back onto each other.
     SelfIntersection { ring: RingRef, edges: [usize; 2] },
     /// A hole's edge meets (crosses or touches) an edge of the outer boundary.
-    HoleCrossesOuter { hole: usize, hole_edge: usize, outer_edge: usize },
+    HoleCrossesOuter {
+        hole: usize,
+        hole_edge: usize,
+        outer_edge: usize,
+    },
     /// A hole lies outside the outer boundary.
     HoleOutside { hole: usize },
     /// Two holes meet or one lies inside the other.
     HolesOverlap { holes: [usize; 2] },
     /// The edge-name list of a ring does not have one entry per edge.
-    EdgeNameCount { ring: RingRef, edges: usize, names: usize },
+    EdgeNameCount {
+        ring: RingRef,
+        edges: usize,
+        names: usize,
+    },
     /// Edge names were given for a ring the polygon does not have.
     EdgeNamesForMissingRing { rings: usize, names: usize },
     /// A circle's radius is not positive and finite, or its centre not finite.
@@ -55,10 +63,16 @@ impl fmt::Display for ShapeError {
         use ShapeError::*;
         match self {
             TooFewVertices { ring, count } => {
-                write!(f, "{ring} has {count} distinct vertices; a polygon needs at least 3")
+                write!(
+                    f,
+                    "{ring} has {count} distinct vertices; a polygon needs at least 3"
+                )
             }
             NonFinite { ring, vertex } => {
-                write!(f, "{ring}: vertex {vertex} has a coordinate that is not a finite number")
+                write!(
+                    f,
+                    "{ring}: vertex {vertex} has a coordinate that is not a finite number"
+                )
             }
             RepeatedVertex { ring, vertex } => write!(
                 f,
@@ -70,7 +84,11 @@ impl fmt::Display for ShapeError {
                 "{ring} intersects itself: edges {} and {} meet",
                 edges[0], edges[1]
             ),
-            HoleCrossesOuter { hole, hole_edge, outer_edge } => write!(
+            HoleCrossesOuter {
+                hole,
+                hole_edge,
+                outer_edge,
+            } => write!(
                 f,
                 "hole {hole} meets the outer boundary: its edge {hole_edge} and outer edge \
                  {outer_edge}"
@@ -123,11 +141,18 @@ impl std::error::Error for ZonesOverlap {}
 #[derive(Debug, Clone, PartialEq)]
 pub enum FillError {
     /// The spacing is not positive and finite.
-    BadSpacing { h: f64 },
+    BadSpacing {
+        h: f64,
+    },
     /// The lattice anchor is not finite.
-    BadAnchor { anchor: [f64; 2] },
+    BadAnchor {
+        anchor: [f64; 2],
+    },
     /// The zones' lattice would have more candidate points than the limit.
-    TooManyPoints { count: f64, limit: usize },
+    TooManyPoints {
+        count: f64,
+        limit: usize,
+    },
     Overlap(ZonesOverlap),
 }
 

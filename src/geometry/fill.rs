@@ -43,7 +43,11 @@ pub struct FillParams {
 
 impl FillParams {
     pub fn new(h: f64, anchor: Point) -> FillParams {
-        FillParams { h, anchor, max_points: DEFAULT_MAX_POINTS }
+        FillParams {
+            h,
+            anchor,
+            max_points: DEFAULT_MAX_POINTS,
+        }
     }
 }
 
@@ -66,22 +70,28 @@ pub struct FilledPoint {
 /// Boundary particles: every polygon edge, after cutting it at the vertices of other zones
 /// lying exactly on it, is divided into `ceil(len / h)` equal parts, its end vertices included;
 /// a circle into `ceil(2 pi r / h)` equal arcs. A shared edge is divided once, from its
-/// lexicographically smaller end, so both zones see bit-identical points.
+/// lexicographically smaller end, so both zones see bit-identical points. Boundary points
+/// within [`SNAP`]` * h` of a lattice node are put exactly on it.
 pub fn fill_zones(zones: &[Shape], params: &FillParams) -> Result<Vec<FilledPoint>, FillError> {
     let h = params.h;
     if !(h.is_finite() && h > 0.0) {
         return Err(FillError::BadSpacing { h });
     }
     if !(params.anchor[0].is_finite() && params.anchor[1].is_finite()) {
-        return Err(FillError::BadAnchor { anchor: params.anchor });
+        return Err(FillError::BadAnchor {
+            anchor: params.anchor,
+        });
     }
     let count: f64 = zones.iter().map(|z| lattice_range(z, params).count()).sum();
     if count > params.max_points as f64 {
-        return Err(FillError::TooManyPoints { count, limit: params.max_points });
+        return Err(FillError::TooManyPoints {
+            count,
+            limit: params.max_points,
+        });
     }
     validate_zones(zones)?;
 
-    let mut points = boundary_points(zones, h);
+    let mut points = boundary_points(zones, params);
     for (z, shape) in zones.iter().enumerate() {
         let r = lattice_range(shape, params);
         for j in r.j0..=r.j1 {
@@ -93,7 +103,11 @@ pub fn fill_zones(zones: &[Shape], params: &FillParams) -> Result<Vec<FilledPoin
                 if shape.locate(p) == Location::Inside
                     && -shape.signed_distance(p) >= DROP_FACTOR * h
                 {
-                    points.push(FilledPoint { position: p, zone: z, on_boundary: false });
+                    points.push(FilledPoint {
+                        position: p,
+                        zone: z,
+                        on_boundary: false,
+                    });
                 }
             }
         }
@@ -153,7 +167,27 @@ fn lex_less(a: Point, b: Point) -> bool {
     a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])).is_lt()
 }
 
-fn boundary_points(zones: &[Shape], h: f64) -> Vec<FilledPoint> {
+/// Boundary points within this many spacings of a lattice node are moved onto it.
+pub const SNAP: f64 = 1e-9;
+
+/// `p`, or the lattice node it lies within [`SNAP`]` * h` of in both coordinates. Edges on
+/// lattice lines then give exactly the lattice's own coordinates, so a rectangle anchored on
+/// the lattice is filled bit for bit as the plain lattice was.
+fn snap(p: Point, params: &FillParams) -> Point {
+    let (a, h) = (params.anchor, params.h);
+    let node = |x: f64, o: f64| {
+        let i = ((x - o) / h).round();
+        let q = o + i * h;
+        ((q - x).abs() <= SNAP * h).then_some(q)
+    };
+    match (node(p[0], a[0]), node(p[1], a[1])) {
+        (Some(x), Some(y)) => [x, y],
+        _ => p,
+    }
+}
+
+fn boundary_points(zones: &[Shape], params: &FillParams) -> Vec<FilledPoint> {
+    let h = params.h;
     let polygons: Vec<(usize, &Polygon)> = zones
         .iter()
         .enumerate()
@@ -175,6 +209,7 @@ fn boundary_points(zones: &[Shape], h: f64) -> Vec<FilledPoint> {
     }
     let mut owner: BTreeMap<[u64; 2], (Point, usize)> = BTreeMap::new();
     let mut put = |p: Point, z: usize| {
+        let p = snap(p, params);
         let e = owner.entry(key(p)).or_insert((p, z));
         e.1 = e.1.min(z);
     };
@@ -197,7 +232,11 @@ fn boundary_points(zones: &[Shape], h: f64) -> Vec<FilledPoint> {
     }
     owner
         .into_values()
-        .map(|(position, zone)| FilledPoint { position, zone, on_boundary: true })
+        .map(|(position, zone)| FilledPoint {
+            position,
+            zone,
+            on_boundary: true,
+        })
         .collect()
 }
 

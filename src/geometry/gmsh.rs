@@ -78,26 +78,48 @@ pub struct GmshError {
 #[derive(Debug, Clone, PartialEq)]
 pub enum GmshErrorKind {
     NotFound,
-    Unreadable { message: String },
+    Unreadable {
+        message: String,
+    },
     /// Not a well-formed MSH 4.1 file.
-    Damaged { detail: String },
+    Damaged {
+        detail: String,
+    },
     /// The `$MeshFormat` version is not 4.1.
-    Version { found: String },
+    Version {
+        found: String,
+    },
     /// A node off the plane z = 0.
-    NodeOutOfPlane { node: u64, z: f64 },
+    NodeOutOfPlane {
+        node: u64,
+        z: f64,
+    },
     /// Volume entities or volume elements.
-    Volumes { count: usize },
+    Volumes {
+        count: usize,
+    },
     NoPhysicalGroups,
     /// Physical groups, but none of dimension 2: nothing to make zones from.
     NoPhysicalSurfaces,
     /// A node inside a surface entity that belongs to two physical surfaces.
-    NodeInTwoSurfaces { node: u64, surfaces: [String; 2] },
+    NodeInTwoSurfaces {
+        node: u64,
+        surfaces: [String; 2],
+    },
     /// Elements on a surface entity that is in no physical surface.
-    UnassignedSurface { entity: i32 },
+    UnassignedSurface {
+        entity: i32,
+    },
     /// An element type other than 3-node triangles, 4-node quadrangles, 2-node lines, points.
-    UnsupportedElement { element: String, entity_dim: i32, entity: i32 },
+    UnsupportedElement {
+        element: String,
+        entity_dim: i32,
+        entity: i32,
+    },
     /// An element refers to a node the file does not define.
-    UnknownNode { node: u64 },
+    UnknownNode {
+        node: u64,
+    },
 }
 
 impl fmt::Display for GmshError {
@@ -117,7 +139,10 @@ impl fmt::Display for GmshError {
                 "{p}: node {node} has z = {z}; only 2D meshes in the plane z = 0 are read"
             ),
             Volumes { count } => {
-                write!(f, "{p}: {count} volume entities or element blocks; only 2D meshes are read")
+                write!(
+                    f,
+                    "{p}: {count} volume entities or element blocks; only 2D meshes are read"
+                )
             }
             NoPhysicalGroups => write!(
                 f,
@@ -130,9 +155,16 @@ impl fmt::Display for GmshError {
                 surfaces[0], surfaces[1]
             ),
             UnassignedSurface { entity } => {
-                write!(f, "{p}: surface {entity} is meshed but in no physical surface")
+                write!(
+                    f,
+                    "{p}: surface {entity} is meshed but in no physical surface"
+                )
             }
-            UnsupportedElement { element, entity_dim, entity } => write!(
+            UnsupportedElement {
+                element,
+                entity_dim,
+                entity,
+            } => write!(
                 f,
                 "{p}: element type {element} on entity ({entity_dim}, {entity}); only 3-node \
                  triangles, 4-node quadrangles and 2-node lines are read"
@@ -146,11 +178,16 @@ impl std::error::Error for GmshError {}
 
 /// Reads and imports the MSH 4.1 file at `path`.
 pub fn read_msh(path: &Path) -> Result<GmshMesh, GmshError> {
-    let err = |kind| GmshError { path: path.to_path_buf(), kind };
+    let err = |kind| GmshError {
+        path: path.to_path_buf(),
+        kind,
+    };
     let bytes = std::fs::read(path).map_err(|e| {
         err(match e.kind() {
             std::io::ErrorKind::NotFound => GmshErrorKind::NotFound,
-            _ => GmshErrorKind::Unreadable { message: e.to_string() },
+            _ => GmshErrorKind::Unreadable {
+                message: e.to_string(),
+            },
         })
     })?;
     parse_msh(path, &bytes)
@@ -158,7 +195,10 @@ pub fn read_msh(path: &Path) -> Result<GmshMesh, GmshError> {
 
 /// Imports MSH 4.1 content; `path` is only used in errors and the result.
 pub fn parse_msh(path: &Path, bytes: &[u8]) -> Result<GmshMesh, GmshError> {
-    let mut mesh = import(bytes).map_err(|kind| GmshError { path: path.to_path_buf(), kind })?;
+    let mut mesh = import(bytes).map_err(|kind| GmshError {
+        path: path.to_path_buf(),
+        kind,
+    })?;
     mesh.path = path.to_path_buf();
     Ok(mesh)
 }
@@ -175,7 +215,9 @@ fn parse(bytes: &[u8]) -> Result<MshFile<u64, i32, f64>, GmshErrorKind> {
     match result {
         Ok(Ok(m)) => Ok(m),
         Ok(Err(detail)) => Err(GmshErrorKind::Damaged { detail }),
-        Err(_) => Err(GmshErrorKind::Damaged { detail: "the parser gave up on malformed data".into() }),
+        Err(_) => Err(GmshErrorKind::Damaged {
+            detail: "the parser gave up on malformed data".into(),
+        }),
     }
 }
 
@@ -192,30 +234,53 @@ fn import(bytes: &[u8]) -> Result<GmshMesh, GmshErrorKind> {
     let Some(entities) = &msh.data.entities else {
         return Err(GmshErrorKind::NoPhysicalGroups);
     };
-    let elements = msh.data.elements.as_ref().map_or(&[][..], |e| &e.element_blocks[..]);
+    let elements = msh
+        .data
+        .elements
+        .as_ref()
+        .map_or(&[][..], |e| &e.element_blocks[..]);
     let volume_blocks = elements.iter().filter(|b| b.entity_dim == 3).count();
     if !entities.volumes.is_empty() || volume_blocks > 0 {
-        return Err(GmshErrorKind::Volumes { count: entities.volumes.len().max(volume_blocks) });
+        return Err(GmshErrorKind::Volumes {
+            count: entities.volumes.len().max(volume_blocks),
+        });
     }
-    let surface_groups: HashMap<i32, &[i32]> =
-        entities.surfaces.iter().map(|s| (s.tag, &s.physical_tags[..])).collect();
-    let curve_groups: HashMap<i32, &[i32]> =
-        entities.curves.iter().map(|c| (c.tag, &c.physical_tags[..])).collect();
+    let surface_groups: HashMap<i32, &[i32]> = entities
+        .surfaces
+        .iter()
+        .map(|s| (s.tag, &s.physical_tags[..]))
+        .collect();
+    let curve_groups: HashMap<i32, &[i32]> = entities
+        .curves
+        .iter()
+        .map(|c| (c.tag, &c.physical_tags[..]))
+        .collect();
     let any_group = entities.points.iter().any(|p| !p.physical_tags.is_empty())
         || curve_groups.values().any(|g| !g.is_empty())
         || surface_groups.values().any(|g| !g.is_empty());
     if !any_group {
         return Err(GmshErrorKind::NoPhysicalGroups);
     }
-    let surface_tags: BTreeSet<i32> = surface_groups.values().flat_map(|g| g.iter().copied()).collect();
+    let surface_tags: BTreeSet<i32> = surface_groups
+        .values()
+        .flat_map(|g| g.iter().copied())
+        .collect();
     if surface_tags.is_empty() {
         return Err(GmshErrorKind::NoPhysicalSurfaces);
     }
-    let surface_index: HashMap<i32, usize> =
-        surface_tags.iter().enumerate().map(|(i, &t)| (t, i)).collect();
+    let surface_index: HashMap<i32, usize> = surface_tags
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| (t, i))
+        .collect();
 
     let (coords, classified) = read_nodes(&msh)?;
-    let lookup = |id: u64| coords.get(&id).copied().ok_or(GmshErrorKind::UnknownNode { node: id });
+    let lookup = |id: u64| {
+        coords
+            .get(&id)
+            .copied()
+            .ok_or(GmshErrorKind::UnknownNode { node: id })
+    };
 
     // Surface elements, by surface index, as node tags.
     let mut tris: Vec<Vec<[u64; 3]>> = vec![Vec::new(); surface_tags.len()];
@@ -234,7 +299,11 @@ fn import(bytes: &[u8]) -> Result<GmshMesh, GmshErrorKind> {
                     .map_or_else(BTreeSet::new, |g| g.iter().copied().collect());
                 let groups: Vec<i32> = groups.into_iter().collect();
                 let s = match groups[..] {
-                    [] => return Err(GmshErrorKind::UnassignedSurface { entity: block.entity_tag }),
+                    [] => {
+                        return Err(GmshErrorKind::UnassignedSurface {
+                            entity: block.entity_tag,
+                        })
+                    }
                     [g] => surface_index[&g],
                     [a, b, ..] => {
                         // Report a node inside the entity: it is certainly in both groups.
@@ -243,7 +312,11 @@ fn import(bytes: &[u8]) -> Result<GmshMesh, GmshErrorKind> {
                             .filter(|(_, &c)| c == (2, block.entity_tag))
                             .map(|(&id, _)| id)
                             .min();
-                        let first = block.elements.first().and_then(|e| e.nodes.first()).copied();
+                        let first = block
+                            .elements
+                            .first()
+                            .and_then(|e| e.nodes.first())
+                            .copied();
                         return Err(GmshErrorKind::NodeInTwoSurfaces {
                             node: inside.or(first).unwrap_or(0),
                             surfaces: [name_of(2, a), name_of(2, b)],
@@ -290,7 +363,12 @@ fn import(bytes: &[u8]) -> Result<GmshMesh, GmshErrorKind> {
     let index: HashMap<u64, usize> = owner.keys().enumerate().map(|(i, &id)| (id, i)).collect();
     let mut nodes = Vec::with_capacity(owner.len());
     for (&id, &surface) in &owner {
-        nodes.push(GmshNode { id, position: lookup(id)?, size: 0.0, surface });
+        nodes.push(GmshNode {
+            id,
+            position: lookup(id)?,
+            size: 0.0,
+            surface,
+        });
     }
     mesh_sizes(&mut nodes, &index, &tris, &quads);
 
@@ -311,9 +389,19 @@ fn import(bytes: &[u8]) -> Result<GmshMesh, GmshErrorKind> {
             .iter()
             .map(|&[a, b]| Ok([lookup(a)?, lookup(b)?]))
             .collect::<Result<Vec<_>, GmshErrorKind>>()?;
-        curves.push(PhysicalCurve { name: name_of(1, tag), tag, segments, coordinates });
+        curves.push(PhysicalCurve {
+            name: name_of(1, tag),
+            tag,
+            segments,
+            coordinates,
+        });
     }
-    Ok(GmshMesh { path: PathBuf::new(), nodes, surfaces, curves })
+    Ok(GmshMesh {
+        path: PathBuf::new(),
+        nodes,
+        surfaces,
+        curves,
+    })
 }
 
 type NodeMaps = (HashMap<u64, Point>, HashMap<u64, (i32, i32)>);
@@ -345,7 +433,10 @@ fn read_nodes(msh: &MshFile<u64, i32, f64>) -> Result<NodeMaps, GmshErrorKind> {
         };
         for (node, &tag) in block.nodes.iter().zip(&tags) {
             if node.z != 0.0 {
-                return Err(GmshErrorKind::NodeOutOfPlane { node: tag, z: node.z });
+                return Err(GmshErrorKind::NodeOutOfPlane {
+                    node: tag,
+                    z: node.z,
+                });
             }
             coords.insert(tag, [node.x, node.y]);
             classified.insert(tag, (block.entity_dim, block.entity_tag));
@@ -381,6 +472,10 @@ fn mesh_sizes(
         }
     }
     for (k, n) in nodes.iter_mut().enumerate() {
-        n.size = if count[k] > 0 { sum[k] / count[k] as f64 } else { 0.0 };
+        n.size = if count[k] > 0 {
+            sum[k] / count[k] as f64
+        } else {
+            0.0
+        };
     }
 }

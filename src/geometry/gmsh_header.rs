@@ -21,7 +21,9 @@ pub(super) fn check_version(bytes: &[u8]) -> Result<(), GmshErrorKind> {
         });
     }
     let Some(format) = it.next() else {
-        return Err(GmshErrorKind::Damaged { detail: "the $MeshFormat section is empty".into() });
+        return Err(GmshErrorKind::Damaged {
+            detail: "the $MeshFormat section is empty".into(),
+        });
     };
     let fields: Vec<&str> = format.split_whitespace().collect();
     let found = fields.first().copied().unwrap_or("").to_string();
@@ -92,16 +94,38 @@ mod tests {
 
     #[test]
     fn versions() {
-        assert_eq!(check_version(b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n"), Ok(()));
+        assert_eq!(
+            check_version(b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n"),
+            Ok(())
+        );
         assert_eq!(
             check_version(b"$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"),
-            Err(GmshErrorKind::Version { found: "2.2".into() })
+            Err(GmshErrorKind::Version {
+                found: "2.2".into()
+            })
         );
-        assert!(matches!(check_version(b"hello"), Err(GmshErrorKind::Damaged { .. })));
-        assert!(matches!(check_version(b"$MeshFormat\n"), Err(GmshErrorKind::Damaged { .. })));
-        for bad in ["4.1 0 999999999999999999999", "4.1 2 8", "4.1 0", "4.1 0 8 x"] {
+        assert!(matches!(
+            check_version(b"hello"),
+            Err(GmshErrorKind::Damaged { .. })
+        ));
+        assert!(matches!(
+            check_version(b"$MeshFormat\n"),
+            Err(GmshErrorKind::Damaged { .. })
+        ));
+        for bad in [
+            "4.1 0 999999999999999999999",
+            "4.1 2 8",
+            "4.1 0",
+            "4.1 0 8 x",
+        ] {
             let text = format!("$MeshFormat\n{bad}\n$EndMeshFormat\n");
-            assert!(matches!(check_version(text.as_bytes()), Err(GmshErrorKind::Damaged { .. })), "{bad}");
+            assert!(
+                matches!(
+                    check_version(text.as_bytes()),
+                    Err(GmshErrorKind::Damaged { .. })
+                ),
+                "{bad}"
+            );
         }
     }
 
@@ -113,9 +137,18 @@ mod tests {
             vec![(1, 3, "sea bed".to_string()), (2, 1, "clay".to_string())]
         );
         let short = b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n3\n1 3 \"a\"\n$EndPhysicalNames\n";
-        assert!(matches!(physical_names(short), Err(GmshErrorKind::Damaged { .. })));
+        assert!(matches!(
+            physical_names(short),
+            Err(GmshErrorKind::Damaged { .. })
+        ));
         let bad = b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n1 x \"a\"\n$EndPhysicalNames\n";
-        assert!(matches!(physical_names(bad), Err(GmshErrorKind::Damaged { .. })));
-        assert_eq!(physical_names(b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n").unwrap(), vec![]);
+        assert!(matches!(
+            physical_names(bad),
+            Err(GmshErrorKind::Damaged { .. })
+        ));
+        assert_eq!(
+            physical_names(b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n").unwrap(),
+            vec![]
+        );
     }
 }

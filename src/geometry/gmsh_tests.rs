@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
 }
 
 /// A fresh directory under the system temp dir, removed on drop.
@@ -18,7 +20,8 @@ impl TempDir {
         let nanos = std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
             .map_or(0, |d| d.as_nanos());
-        let dir = std::env::temp_dir().join(format!("pfem-geo-{tag}-{}-{nanos}", std::process::id()));
+        let dir =
+            std::env::temp_dir().join(format!("pfem-geo-{tag}-{}-{nanos}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         TempDir(dir)
     }
@@ -44,29 +47,55 @@ fn check_layered_site(m: &GmshMesh, file_nodes: usize) {
         let area: f64 = s
             .triangles
             .iter()
-            .map(|t| 0.5 * orient(m.nodes[t[0]].position, m.nodes[t[1]].position, m.nodes[t[2]].position).abs())
+            .map(|t| {
+                0.5 * orient(
+                    m.nodes[t[0]].position,
+                    m.nodes[t[1]].position,
+                    m.nodes[t[2]].position,
+                )
+                .abs()
+            })
             .sum();
         assert!((area - want).abs() < 1e-9, "{}: {area}", s.name);
     }
     // Interface nodes (y = 4) are used by both layers and owned by the lower tag.
-    let interface: Vec<usize> = (0..m.nodes.len()).filter(|&k| m.nodes[k].position[1] == 4.0).collect();
+    let interface: Vec<usize> = (0..m.nodes.len())
+        .filter(|&k| m.nodes[k].position[1] == 4.0)
+        .collect();
     assert!(interface.len() >= 3);
     for &k in &interface {
         assert_eq!(m.nodes[k].surface, 0);
         assert!(m.surfaces.iter().all(|s| s.nodes.binary_search(&k).is_ok()));
     }
     for n in &m.nodes {
-        let expect = if n.position[1] < 4.0 { 0 } else if n.position[1] > 4.0 { 1 } else { 0 };
+        let expect = if n.position[1] < 4.0 {
+            0
+        } else if n.position[1] > 4.0 {
+            1
+        } else {
+            0
+        };
         assert_eq!(n.surface, expect, "{n:?}");
         assert!(n.size > 0.0);
     }
     // The seabed is the top, y = 7, covered once from x = 0 to 20.
     let seabed = &m.curves[1];
-    assert!(seabed.coordinates.iter().all(|s| s[0][1] == 7.0 && s[1][1] == 7.0));
-    let len: f64 = seabed.coordinates.iter().map(|s| (s[1][0] - s[0][0]).abs()).sum();
+    assert!(seabed
+        .coordinates
+        .iter()
+        .all(|s| s[0][1] == 7.0 && s[1][1] == 7.0));
+    let len: f64 = seabed
+        .coordinates
+        .iter()
+        .map(|s| (s[1][0] - s[0][0]).abs())
+        .sum();
     assert!((len - 20.0).abs() < 1e-9);
     let sides = &m.curves[2];
-    let len: f64 = sides.coordinates.iter().map(|s| (s[1][1] - s[0][1]).abs()).sum();
+    let len: f64 = sides
+        .coordinates
+        .iter()
+        .map(|s| (s[1][1] - s[0][1]).abs())
+        .sum();
     assert!((len - 14.0).abs() < 1e-9);
     assert_eq!(seabed.segments.len(), seabed.coordinates.len());
 }
@@ -75,7 +104,10 @@ fn file_node_count(bytes: &[u8]) -> usize {
     let text = String::from_utf8_lossy(bytes);
     let mut lines = text.lines().skip_while(|l| l.trim() != "$Nodes");
     lines.next();
-    lines.next().and_then(|l| l.split_whitespace().nth(1)?.parse().ok()).unwrap()
+    lines
+        .next()
+        .and_then(|l| l.split_whitespace().nth(1)?.parse().ok())
+        .unwrap()
 }
 
 #[test]
@@ -100,12 +132,21 @@ fn gmsh_meshes_the_committed_geo_in_ascii_and_binary() {
     for binary in [false, true] {
         let out = dir.0.join(if binary { "bin.msh" } else { "ascii.msh" });
         let mut cmd = Command::new("gmsh");
-        cmd.arg("-2").arg("-format").arg("msh41").arg(data("layered-site.geo")).arg("-o").arg(&out);
+        cmd.arg("-2")
+            .arg("-format")
+            .arg("msh41")
+            .arg(data("layered-site.geo"))
+            .arg("-o")
+            .arg(&out);
         if binary {
             cmd.arg("-bin");
         }
         let status = cmd.output().unwrap();
-        assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
+        assert!(
+            status.status.success(),
+            "{}",
+            String::from_utf8_lossy(&status.stderr)
+        );
         meshes.push(read_msh(&out).unwrap());
     }
     let ascii_nodes = file_node_count(&std::fs::read(dir.0.join("ascii.msh")).unwrap());
@@ -116,9 +157,16 @@ fn gmsh_meshes_the_committed_geo_in_ascii_and_binary() {
     assert_eq!(a.nodes.len(), b.nodes.len());
     for (p, q) in a.nodes.iter().zip(&b.nodes) {
         assert_eq!((p.id, p.surface), (q.id, q.surface));
-        assert!((p.position[0] - q.position[0]).abs() + (p.position[1] - q.position[1]).abs() < 1e-12);
+        assert!(
+            (p.position[0] - q.position[0]).abs() + (p.position[1] - q.position[1]).abs() < 1e-12
+        );
     }
-    let segs = |m: &GmshMesh| m.curves.iter().map(|c| (c.name.clone(), c.segments.clone())).collect::<Vec<_>>();
+    let segs = |m: &GmshMesh| {
+        m.curves
+            .iter()
+            .map(|c| (c.name.clone(), c.segments.clone()))
+            .collect::<Vec<_>>()
+    };
     assert!(segs(a) == segs(b), "curves differ");
     // lc = 1 in the .geo.
     let mean = a.nodes.iter().map(|n| n.size).sum::<f64>() / a.nodes.len() as f64;
@@ -140,14 +188,29 @@ fn tiny(z: f64, phys: &[i32], names: &str, volume: bool) -> String {
 }
 
 fn kind(text: &str) -> GmshErrorKind {
-    parse_msh(Path::new("t.msh"), text.as_bytes()).unwrap_err().kind
+    parse_msh(Path::new("t.msh"), text.as_bytes())
+        .unwrap_err()
+        .kind
 }
 
 #[test]
 fn tiny_file_imports() {
-    let m = parse_msh(Path::new("t.msh"), tiny(0.0, &[7], "$PhysicalNames\n1\n2 7 \"clay\"\n$EndPhysicalNames\n", false).as_bytes()).unwrap();
+    let m = parse_msh(
+        Path::new("t.msh"),
+        tiny(
+            0.0,
+            &[7],
+            "$PhysicalNames\n1\n2 7 \"clay\"\n$EndPhysicalNames\n",
+            false,
+        )
+        .as_bytes(),
+    )
+    .unwrap();
     assert_eq!(m.surfaces.len(), 1);
-    assert_eq!((m.surfaces[0].name.as_str(), m.surfaces[0].tag), ("clay", 7));
+    assert_eq!(
+        (m.surfaces[0].name.as_str(), m.surfaces[0].tag),
+        ("clay", 7)
+    );
     assert_eq!(m.surfaces[0].triangles, vec![[0, 1, 2]]);
     assert_eq!(m.nodes[2].position, [0.0, 1.0]);
     // Node 1's edges: 1 and 1.
@@ -164,23 +227,42 @@ fn refusals_name_the_file_and_the_reason() {
     assert!(e.to_string().contains("/nonexistent/site.msh"));
     assert_eq!(
         kind("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n0\n$EndNodes\n"),
-        GmshErrorKind::Version { found: "2.2".into() }
+        GmshErrorKind::Version {
+            found: "2.2".into()
+        }
     );
-    assert_eq!(kind(&tiny(0.5, &[1], "", false)), GmshErrorKind::NodeOutOfPlane { node: 3, z: 0.5 });
-    assert_eq!(kind(&tiny(0.0, &[1], "", true)), GmshErrorKind::Volumes { count: 1 });
-    assert_eq!(kind(&tiny(0.0, &[], "", false)), GmshErrorKind::NoPhysicalGroups);
+    assert_eq!(
+        kind(&tiny(0.5, &[1], "", false)),
+        GmshErrorKind::NodeOutOfPlane { node: 3, z: 0.5 }
+    );
+    assert_eq!(
+        kind(&tiny(0.0, &[1], "", true)),
+        GmshErrorKind::Volumes { count: 1 }
+    );
+    assert_eq!(
+        kind(&tiny(0.0, &[], "", false)),
+        GmshErrorKind::NoPhysicalGroups
+    );
     let names = "$PhysicalNames\n2\n2 1 \"soft\"\n2 2 \"stiff\"\n$EndPhysicalNames\n";
     assert_eq!(
         kind(&tiny(0.0, &[1, 2], names, false)),
-        GmshErrorKind::NodeInTwoSurfaces { node: 1, surfaces: ["soft".into(), "stiff".into()] }
+        GmshErrorKind::NodeInTwoSurfaces {
+            node: 1,
+            surfaces: ["soft".into(), "stiff".into()]
+        }
     );
-    let unknown = tiny(0.0, &[1], "", false).replace("1 1 2 3\n$EndElements", "1 1 2 9\n$EndElements");
+    let unknown =
+        tiny(0.0, &[1], "", false).replace("1 1 2 3\n$EndElements", "1 1 2 9\n$EndElements");
     assert_eq!(kind(&unknown), GmshErrorKind::UnknownNode { node: 9 });
     // mshio unwraps the data-size field and would panic on this one.
     let huge = "$MeshFormat\n4.1 0 99999999999999999999999\n$EndMeshFormat\n";
     assert!(matches!(kind(huge), GmshErrorKind::Damaged { .. }));
-    let quad9 = tiny(0.0, &[1], "", false).replace("2 1 2 1\n1 1 2 3\n", "2 1 10 1\n1 1 2 3 1 2 3 1 2 3\n");
-    assert!(matches!(kind(&quad9), GmshErrorKind::UnsupportedElement { .. }));
+    let quad9 =
+        tiny(0.0, &[1], "", false).replace("2 1 2 1\n1 1 2 3\n", "2 1 10 1\n1 1 2 3 1 2 3 1 2 3\n");
+    assert!(matches!(
+        kind(&quad9),
+        GmshErrorKind::UnsupportedElement { .. }
+    ));
 }
 
 #[test]
@@ -231,5 +313,8 @@ fn truncated_and_garbled_files_are_damaged_not_panics() {
         }
     }
     // Every truncated file is refused.
-    assert!(refused >= 39 + if made { 19 } else { 0 }, "{refused} refused");
+    assert!(
+        refused >= 39 + if made { 19 } else { 0 },
+        "{refused} refused"
+    );
 }

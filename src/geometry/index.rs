@@ -42,7 +42,9 @@ impl EdgeGrid {
         let origin = [lo[0] - pad, lo[1] - pad];
         let (w, h) = (w + 2.0 * pad, h + 2.0 * pad);
         let target = (2 * segs.len()).max(1) as f64;
-        let cell = (w * h / target).sqrt().max(w.max(h) / MAX_CELLS_PER_AXIS as f64);
+        let cell = (w * h / target)
+            .sqrt()
+            .max(w.max(h) / MAX_CELLS_PER_AXIS as f64);
         let nx = ((w / cell).ceil() as usize).clamp(1, MAX_CELLS_PER_AXIS);
         let ny = ((h / cell).ceil() as usize).clamp(1, MAX_CELLS_PER_AXIS);
         let mut grid = EdgeGrid {
@@ -146,7 +148,15 @@ impl EdgeGrid {
         let (ci, cj) = self.raw_cell(p);
         let (nx, ny) = (self.nx as i64, self.ny as i64);
         // Rings closer than the grid are empty; start at the first that reaches it.
-        let gap = |c: i64, n: i64| if c < 0 { -c } else if c >= n { c - n + 1 } else { 0 };
+        let gap = |c: i64, n: i64| {
+            if c < 0 {
+                -c
+            } else if c >= n {
+                c - n + 1
+            } else {
+                0
+            }
+        };
         let k0 = gap(ci, nx).max(gap(cj, ny));
         let kmax = k0 + nx.max(ny);
         let mut best: Option<(f64, usize)> = None;
@@ -274,7 +284,7 @@ impl Locator {
     }
 
     pub fn locate(&self, p: Point) -> Location {
-        if !(p[0].is_finite() && p[1].is_finite()) || !self.grid.inside_grid(p) {
+        if !(p[0].is_finite() && p[1].is_finite() && self.grid.inside_grid(p)) {
             return Location::Outside;
         }
         let (i, j) = self.grid.cell_of(p);
@@ -346,7 +356,9 @@ mod tests {
     use super::*;
 
     fn ring(pts: &[Point]) -> Vec<[Point; 2]> {
-        (0..pts.len()).map(|k| [pts[k], pts[(k + 1) % pts.len()]]).collect()
+        (0..pts.len())
+            .map(|k| [pts[k], pts[(k + 1) % pts.len()]])
+            .collect()
     }
 
     fn brute_parity(segs: &[[Point; 2]], p: Point) -> bool {
@@ -380,12 +392,16 @@ mod tests {
         let mut disagreements = 0;
         for _ in 0..20_000 {
             let mut u = || {
-                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 (state >> 11) as f64 / (1u64 << 53) as f64 * 2.4 - 1.2
             };
             let p = [u(), u()];
             let got = loc.locate(p);
-            let near = segs.iter().any(|s| segment::distance(s[0], s[1], p) < 1e-12);
+            let near = segs
+                .iter()
+                .any(|s| segment::distance(s[0], s[1], p) < 1e-12);
             if near {
                 continue;
             }
@@ -426,7 +442,10 @@ mod tests {
         let grid = EdgeGrid::new(segs.clone());
         for k in 0..2000 {
             let t = k as f64 * 0.7548776662466927;
-            let p = [3.0 * (t.fract() - 0.5) * (1.0 + (k % 7) as f64), 3.0 * ((t * 1.3).fract() - 0.5)];
+            let p = [
+                3.0 * (t.fract() - 0.5) * (1.0 + (k % 7) as f64),
+                3.0 * ((t * 1.3).fract() - 0.5),
+            ];
             let brute = segs
                 .iter()
                 .map(|s| segment::distance(s[0], s[1], p))

@@ -24,9 +24,9 @@ pub fn overlap(a: &Shape, b: &Shape) -> bool {
     }
     match (a, b) {
         (Shape::Circle(c), Shape::Circle(d)) => circles_overlap(c, d),
-        (Shape::Circle(c), other) | (other, Shape::Circle(c)) => {
-            other.as_polygon().is_some_and(|p| circle_polygon_overlap(c, p))
-        }
+        (Shape::Circle(c), other) | (other, Shape::Circle(c)) => other
+            .as_polygon()
+            .is_some_and(|p| circle_polygon_overlap(c, p)),
         _ => match (a.as_polygon(), b.as_polygon()) {
             (Some(p), Some(q)) => polygons_overlap(p, q),
             _ => false,
@@ -86,9 +86,9 @@ fn polygons_overlap(p: &Polygon, q: &Polygon) -> bool {
             return true;
         }
     }
-    q_pieces
-        .iter()
-        .any(|&[a, b]| !p_set.contains(&key(b, a)) && !p_set.contains(&key(a, b)) && piece_inside(a, b, p))
+    q_pieces.iter().any(|&[a, b]| {
+        !p_set.contains(&key(b, a)) && !p_set.contains(&key(a, b)) && piece_inside(a, b, p)
+    })
 }
 
 /// Whether the open piece `a b`, which meets `other`'s boundary at most at its ends, lies inside

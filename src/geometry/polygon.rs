@@ -52,7 +52,10 @@ impl Polygon {
         rings.extend(holes.iter().map(|h| open_ring(h)));
         check_rings(&rings)?;
         if names.len() > rings.len() {
-            return Err(ShapeError::EdgeNamesForMissingRing { rings: rings.len(), names: names.len() });
+            return Err(ShapeError::EdgeNamesForMissingRing {
+                rings: rings.len(),
+                names: names.len(),
+            });
         }
         names.resize(rings.len(), Vec::new());
         let mut input_edge = Vec::with_capacity(rings.len());
@@ -62,8 +65,16 @@ impl Polygon {
             if ring_names.is_empty() {
                 ring_names.resize(n, None);
             } else if ring_names.len() != n {
-                let ring = if k == 0 { RingRef::Outer } else { RingRef::Hole(k - 1) };
-                return Err(ShapeError::EdgeNameCount { ring, edges: n, names: ring_names.len() });
+                let ring = if k == 0 {
+                    RingRef::Outer
+                } else {
+                    RingRef::Hole(k - 1)
+                };
+                return Err(ShapeError::EdgeNameCount {
+                    ring,
+                    edges: n,
+                    names: ring_names.len(),
+                });
             }
             if is_ccw(ring) == (k == 0) {
                 input_edge.push((0..n).collect());
@@ -84,7 +95,14 @@ impl Polygon {
                 bbox[1][k] = bbox[1][k].max(p[k]);
             }
         }
-        Ok(Polygon { rings, names, input_edge, locator: Locator::new(segs), area, bbox })
+        Ok(Polygon {
+            rings,
+            names,
+            input_edge,
+            locator: Locator::new(segs),
+            area,
+            bbox,
+        })
     }
 
     /// The outer ring, counter-clockwise.
@@ -113,7 +131,10 @@ impl Polygon {
 
     /// Distance from `p` to the nearest edge of any ring.
     pub fn boundary_distance(&self, p: Point) -> f64 {
-        self.locator.grid().nearest(p).map_or(f64::INFINITY, |(d, _)| d)
+        self.locator
+            .grid()
+            .nearest(p)
+            .map_or(f64::INFINITY, |(d, _)| d)
     }
 
     /// Distance to the boundary, negative inside, zero on it.
@@ -145,7 +166,11 @@ impl Polygon {
                     a: ring[m],
                     b: ring[(m + 1) % n],
                     name: self.names[k][m].clone(),
-                    ring: if k == 0 { RingRef::Outer } else { RingRef::Hole(k - 1) },
+                    ring: if k == 0 {
+                        RingRef::Outer
+                    } else {
+                        RingRef::Hole(k - 1)
+                    },
                     edge: self.input_edge[k][m],
                 });
             }
@@ -172,7 +197,11 @@ pub(super) fn cut_edges(p: &Polygon, others: &[&Polygon]) -> Vec<[Point; 2]> {
     for (s, &[a, b]) in segs.iter().enumerate() {
         let mut pts = std::mem::take(&mut cuts[s]);
         // Collinear with a b: the order along the dominant axis is the order along the edge.
-        let axis = if (b[0] - a[0]).abs() >= (b[1] - a[1]).abs() { 0 } else { 1 };
+        let axis = if (b[0] - a[0]).abs() >= (b[1] - a[1]).abs() {
+            0
+        } else {
+            1
+        };
         let dir = (b[axis] - a[axis]).signum();
         pts.sort_by(|u, v| (dir * u[axis]).total_cmp(&(dir * v[axis])));
         pts.dedup();
@@ -203,7 +232,14 @@ mod tests {
     use super::*;
 
     fn l_shape() -> Vec<Point> {
-        vec![[0.0, 0.0], [4.0, 0.0], [4.0, 2.0], [2.0, 2.0], [2.0, 4.0], [0.0, 4.0]]
+        vec![
+            [0.0, 0.0],
+            [4.0, 0.0],
+            [4.0, 2.0],
+            [2.0, 2.0],
+            [2.0, 4.0],
+            [0.0, 4.0],
+        ]
     }
 
     #[test]
@@ -220,14 +256,23 @@ mod tests {
         let p = Polygon::with_edge_names(cw, vec![hole], vec![names]).unwrap();
         assert_eq!(p.area(), 12.0 - 1.0);
         let b = p.boundary();
-        let left = b.iter().find(|s| s.name.as_deref() == Some("left")).unwrap();
+        let left = b
+            .iter()
+            .find(|s| s.name.as_deref() == Some("left"))
+            .unwrap();
         assert_eq!((left.a, left.b, left.edge), ([0.0, 4.0], [0.0, 0.0], 0));
-        let base = b.iter().find(|s| s.name.as_deref() == Some("base")).unwrap();
+        let base = b
+            .iter()
+            .find(|s| s.name.as_deref() == Some("base"))
+            .unwrap();
         assert_eq!((base.a, base.b, base.edge), ([0.0, 0.0], [4.0, 0.0], 5));
         // Interior on the left of every edge: the midpoint nudged left is inside.
         for s in &b {
             let m = [0.5 * (s.a[0] + s.b[0]), 0.5 * (s.a[1] + s.b[1])];
-            let left = [m[0] - 1e-6 * (s.b[1] - s.a[1]), m[1] + 1e-6 * (s.b[0] - s.a[0])];
+            let left = [
+                m[0] - 1e-6 * (s.b[1] - s.a[1]),
+                m[1] + 1e-6 * (s.b[0] - s.a[0]),
+            ];
             assert_eq!(p.locate(left), Location::Inside, "{s:?}");
         }
         assert_eq!(b.iter().filter(|s| s.ring == RingRef::Hole(0)).count(), 4);
@@ -254,7 +299,11 @@ mod tests {
     fn edge_name_counts_are_checked() {
         assert_eq!(
             Polygon::with_edge_names(l_shape(), vec![], vec![vec![None; 5]]).unwrap_err(),
-            ShapeError::EdgeNameCount { ring: RingRef::Outer, edges: 6, names: 5 }
+            ShapeError::EdgeNameCount {
+                ring: RingRef::Outer,
+                edges: 6,
+                names: 5
+            }
         );
         assert_eq!(
             Polygon::with_edge_names(l_shape(), vec![], vec![vec![], vec![]]).unwrap_err(),

@@ -27,7 +27,10 @@ fn sign(x: f64) -> i8 {
 /// Whether `p`, known to be collinear with `a` and `b`, lies within their closed bounding box.
 #[inline]
 fn within_box(a: Point, b: Point, p: Point) -> bool {
-    p[0] >= a[0].min(b[0]) && p[0] <= a[0].max(b[0]) && p[1] >= a[1].min(b[1]) && p[1] <= a[1].max(b[1])
+    p[0] >= a[0].min(b[0])
+        && p[0] <= a[0].max(b[0])
+        && p[1] >= a[1].min(b[1])
+        && p[1] <= a[1].max(b[1])
 }
 
 /// Whether `p` lies on the closed segment `a b` (exact).
@@ -80,7 +83,11 @@ pub fn collinear_overlap(a: Point, b: Point, c: Point, d: Point) -> bool {
         return false;
     }
     // Project on the dominant axis, where the order along the line is exact.
-    let axis = if (b[0] - a[0]).abs() >= (b[1] - a[1]).abs() { 0 } else { 1 };
+    let axis = if (b[0] - a[0]).abs() >= (b[1] - a[1]).abs() {
+        0
+    } else {
+        1
+    };
     let (lo1, hi1) = (a[axis].min(b[axis]), a[axis].max(b[axis]));
     let (lo2, hi2) = (c[axis].min(d[axis]), c[axis].max(d[axis]));
     lo1.max(lo2) < hi1.min(hi2)

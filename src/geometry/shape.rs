@@ -17,11 +17,16 @@ pub struct Circle {
 
 impl Circle {
     pub fn new(centre: Point, radius: f64) -> Result<Circle, ShapeError> {
-        let ok = centre[0].is_finite() && centre[1].is_finite() && radius.is_finite() && radius > 0.0;
+        let ok =
+            centre[0].is_finite() && centre[1].is_finite() && radius.is_finite() && radius > 0.0;
         if !ok {
             return Err(ShapeError::BadCircle { centre, radius });
         }
-        Ok(Circle { centre, radius, name: None })
+        Ok(Circle {
+            centre,
+            radius,
+            name: None,
+        })
     }
 
     /// Names the whole circumference as one boundary.
@@ -54,7 +59,10 @@ impl Circle {
     /// Point `k` of `n` equally spaced points, the first at angle 0.
     pub fn point(&self, k: usize, n: usize) -> Point {
         let t = 2.0 * PI * k as f64 / n as f64;
-        [self.centre[0] + self.radius * t.cos(), self.centre[1] + self.radius * t.sin()]
+        [
+            self.centre[0] + self.radius * t.cos(),
+            self.centre[1] + self.radius * t.sin(),
+        ]
     }
 
     /// The circle's vertices as a polygon ring at spacing about `h`: a circular hole in a
@@ -87,12 +95,22 @@ impl Rectangle {
         let finite = origin.iter().chain(size.iter()).all(|v| v.is_finite());
         let corner = [origin[0] + size[0], origin[1] + size[1]];
         // A size below the origin's resolution would make a degenerate polygon.
-        if !finite || !(size[0] > 0.0 && size[1] > 0.0) || corner[0] == origin[0] || corner[1] == origin[1] {
+        let positive = size[0] > 0.0 && size[1] > 0.0;
+        if !(finite && positive) || corner[0] == origin[0] || corner[1] == origin[1] {
             return Err(ShapeError::BadRectangle { origin, size });
         }
-        let outer = vec![origin, [corner[0], origin[1]], corner, [origin[0], corner[1]]];
+        let outer = vec![
+            origin,
+            [corner[0], origin[1]],
+            corner,
+            [origin[0], corner[1]],
+        ];
         let polygon = Polygon::with_edge_names(outer, vec![], vec![names.to_vec()])?;
-        Ok(Rectangle { origin, size, polygon })
+        Ok(Rectangle {
+            origin,
+            size,
+            polygon,
+        })
     }
 
     pub fn origin(&self) -> Point {
@@ -154,7 +172,9 @@ impl Shape {
     pub fn signed_distance(&self, p: Point) -> f64 {
         match self {
             Shape::Circle(c) => c.signed_distance(p),
-            _ => self.as_polygon().map_or(f64::INFINITY, |q| q.signed_distance(p)),
+            _ => self
+                .as_polygon()
+                .map_or(f64::INFINITY, |q| q.signed_distance(p)),
         }
     }
 
@@ -212,21 +232,38 @@ mod tests {
         assert!((c.area() - 4.0 * PI).abs() < 1e-12);
         let b = c.boundary(0.5);
         assert_eq!(b.len(), (4.0 * PI / 0.5).ceil() as usize);
-        assert!(b.iter().all(|s| (crate::geometry::segment::length(s.a, s.b) - 0.5).abs() < 0.03));
-        assert_eq!(Circle::new([0.0, 0.0], 0.0), Err(ShapeError::BadCircle { centre: [0.0, 0.0], radius: 0.0 }));
+        assert!(b
+            .iter()
+            .all(|s| (crate::geometry::segment::length(s.a, s.b) - 0.5).abs() < 0.03));
+        assert_eq!(
+            Circle::new([0.0, 0.0], 0.0),
+            Err(ShapeError::BadCircle {
+                centre: [0.0, 0.0],
+                radius: 0.0
+            })
+        );
         assert!(Circle::new([f64::NAN, 0.0], 1.0).is_err());
     }
 
     #[test]
     fn rectangle_is_its_polygon_with_named_sides() {
-        let names = [Some("base".to_string()), None, Some("top".to_string()), None];
+        let names = [
+            Some("base".to_string()),
+            None,
+            Some("top".to_string()),
+            None,
+        ];
         let r = Rectangle::with_edge_names([1.0, 1.0], [2.0, 3.0], names).unwrap();
         let s = Shape::Rectangle(r);
         assert_eq!(s.area(), 6.0);
         assert_eq!(s.bbox(), [[1.0, 1.0], [3.0, 4.0]]);
         assert_eq!(s.locate([3.0, 2.0]), Location::Boundary);
         assert_eq!(s.signed_distance([2.0, 2.0]), -1.0);
-        let top = s.boundary(1.0).into_iter().find(|e| e.name.as_deref() == Some("top")).unwrap();
+        let top = s
+            .boundary(1.0)
+            .into_iter()
+            .find(|e| e.name.as_deref() == Some("top"))
+            .unwrap();
         assert_eq!((top.a, top.b), ([3.0, 4.0], [1.0, 4.0]));
         assert!(Rectangle::new([0.0, 0.0], [1.0, -1.0]).is_err());
         assert!(Rectangle::new([1e20, 0.0], [1.0, 1.0]).is_err());

@@ -24,15 +24,27 @@ pub(super) fn open_ring(ring: &[Point]) -> Vec<Point> {
 
 fn check_ring(k: usize, ring: &[Point]) -> Result<(), ShapeError> {
     let ring_id = ring_ref(k);
-    if let Some(vertex) = ring.iter().position(|p| !(p[0].is_finite() && p[1].is_finite())) {
-        return Err(ShapeError::NonFinite { ring: ring_id, vertex });
+    if let Some(vertex) = ring
+        .iter()
+        .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+    {
+        return Err(ShapeError::NonFinite {
+            ring: ring_id,
+            vertex,
+        });
     }
     if ring.len() < 3 {
-        return Err(ShapeError::TooFewVertices { ring: ring_id, count: ring.len() });
+        return Err(ShapeError::TooFewVertices {
+            ring: ring_id,
+            count: ring.len(),
+        });
     }
     let n = ring.len();
     if let Some(vertex) = (0..n).find(|&i| ring[i] == ring[(i + 1) % n]) {
-        return Err(ShapeError::RepeatedVertex { ring: ring_id, vertex });
+        return Err(ShapeError::RepeatedVertex {
+            ring: ring_id,
+            vertex,
+        });
     }
     if ring.iter().all(|&p| orient(ring[0], ring[1], p) == 0.0) {
         return Err(ShapeError::ZeroArea { ring: ring_id });
@@ -73,15 +85,27 @@ pub(super) fn check_rings(rings: &[Vec<Point>]) -> Result<(), ShapeError> {
             continue;
         }
         return Err(match (rs, rt) {
-            (r, q) if r == q => ShapeError::SelfIntersection { ring: ring_ref(r), edges: [es, et] },
-            (0, h) => ShapeError::HoleCrossesOuter { hole: h - 1, hole_edge: et, outer_edge: es },
-            (h, g) => ShapeError::HolesOverlap { holes: [h - 1, g - 1] },
+            (r, q) if r == q => ShapeError::SelfIntersection {
+                ring: ring_ref(r),
+                edges: [es, et],
+            },
+            (0, h) => ShapeError::HoleCrossesOuter {
+                hole: h - 1,
+                hole_edge: et,
+                outer_edge: es,
+            },
+            (h, g) => ShapeError::HolesOverlap {
+                holes: [h - 1, g - 1],
+            },
         });
     }
     // No two rings meet now, so one vertex of a ring tells on which side of another it lies.
-    let locators: Vec<Locator> = rings.iter().map(|r| Locator::new(ring_segments(r))).collect();
-    for h in 1..rings.len() {
-        if locators[0].locate(rings[h][0]) != Location::Inside {
+    let locators: Vec<Locator> = rings
+        .iter()
+        .map(|r| Locator::new(ring_segments(r)))
+        .collect();
+    for (h, hole) in rings.iter().enumerate().skip(1) {
+        if locators[0].locate(hole[0]) != Location::Inside {
             return Err(ShapeError::HoleOutside { hole: h - 1 });
         }
     }
@@ -90,7 +114,9 @@ pub(super) fn check_rings(rings: &[Vec<Point>]) -> Result<(), ShapeError> {
             if locators[b].locate(rings[a][0]) == Location::Inside
                 || locators[a].locate(rings[b][0]) == Location::Inside
             {
-                return Err(ShapeError::HolesOverlap { holes: [a - 1, b - 1] });
+                return Err(ShapeError::HolesOverlap {
+                    holes: [a - 1, b - 1],
+                });
             }
         }
     }
@@ -98,7 +124,9 @@ pub(super) fn check_rings(rings: &[Vec<Point>]) -> Result<(), ShapeError> {
 }
 
 pub(super) fn ring_segments(ring: &[Point]) -> Vec<[Point; 2]> {
-    (0..ring.len()).map(|i| [ring[i], ring[(i + 1) % ring.len()]]).collect()
+    (0..ring.len())
+        .map(|i| [ring[i], ring[(i + 1) % ring.len()]])
+        .collect()
 }
 
 /// Whether a valid ring runs counter-clockwise. Exact: at the lexicographically smallest vertex
@@ -107,7 +135,9 @@ pub(super) fn is_ccw(ring: &[Point]) -> bool {
     let n = ring.len();
     let k = (0..n)
         .min_by(|&i, &j| {
-            ring[i][0].total_cmp(&ring[j][0]).then(ring[i][1].total_cmp(&ring[j][1]))
+            ring[i][0]
+                .total_cmp(&ring[j][0])
+                .then(ring[i][1].total_cmp(&ring[j][1]))
         })
         .unwrap_or(0);
     orient(ring[(k + n - 1) % n], ring[k], ring[(k + 1) % n]) > 0.0
@@ -144,22 +174,38 @@ mod tests {
         let bow = [[0.0, 0.0], [2.0, 2.0], [2.0, 0.0], [0.0, 2.0]];
         assert_eq!(
             check(&bow, &[]),
-            Err(ShapeError::SelfIntersection { ring: RingRef::Outer, edges: [0, 2] })
+            Err(ShapeError::SelfIntersection {
+                ring: RingRef::Outer,
+                edges: [0, 2]
+            })
         );
     }
 
     #[test]
     fn a_ring_touching_itself_at_a_vertex_is_not_simple() {
         // Vertex 2 lies on edge 4 (from vertex 4 back to vertex 0).
-        let pinch = [[0.0, 0.0], [4.0, 0.0], [2.0, 2.0], [4.0, 4.0], [0.0, 4.0], [2.0, 2.0]];
+        let pinch = [
+            [0.0, 0.0],
+            [4.0, 0.0],
+            [2.0, 2.0],
+            [4.0, 4.0],
+            [0.0, 4.0],
+            [2.0, 2.0],
+        ];
         assert!(matches!(
             check(&pinch, &[]),
-            Err(ShapeError::SelfIntersection { ring: RingRef::Outer, .. })
+            Err(ShapeError::SelfIntersection {
+                ring: RingRef::Outer,
+                ..
+            })
         ));
         let touch = [[0.0, 0.0], [4.0, 0.0], [0.0, 2.0], [4.0, 4.0], [0.0, 4.0]];
         assert_eq!(
             check(&touch, &[]),
-            Err(ShapeError::SelfIntersection { ring: RingRef::Outer, edges: [1, 4] })
+            Err(ShapeError::SelfIntersection {
+                ring: RingRef::Outer,
+                edges: [1, 4]
+            })
         );
     }
 
@@ -168,7 +214,10 @@ mod tests {
         let spike = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [4.0, 2.0], [0.0, 4.0]];
         assert_eq!(
             check(&spike, &[]),
-            Err(ShapeError::SelfIntersection { ring: RingRef::Outer, edges: [1, 2] })
+            Err(ShapeError::SelfIntersection {
+                ring: RingRef::Outer,
+                edges: [1, 2]
+            })
         );
     }
 
@@ -176,40 +225,65 @@ mod tests {
     fn counts_areas_and_numbers() {
         assert_eq!(
             check(&[[0.0, 0.0], [1.0, 0.0]], &[]),
-            Err(ShapeError::TooFewVertices { ring: RingRef::Outer, count: 2 })
+            Err(ShapeError::TooFewVertices {
+                ring: RingRef::Outer,
+                count: 2
+            })
         );
         assert_eq!(
             check(&[[0.0, 0.0], [1.0, 1.0], [3.0, 3.0]], &[]),
-            Err(ShapeError::ZeroArea { ring: RingRef::Outer })
+            Err(ShapeError::ZeroArea {
+                ring: RingRef::Outer
+            })
         );
         assert_eq!(
             check(&[[0.0, 0.0], [1.0, f64::NAN], [3.0, 3.0]], &[]),
-            Err(ShapeError::NonFinite { ring: RingRef::Outer, vertex: 1 })
+            Err(ShapeError::NonFinite {
+                ring: RingRef::Outer,
+                vertex: 1
+            })
         );
         assert_eq!(
             check(&[[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [0.0, 1.0]], &[]),
-            Err(ShapeError::RepeatedVertex { ring: RingRef::Outer, vertex: 1 })
+            Err(ShapeError::RepeatedVertex {
+                ring: RingRef::Outer,
+                vertex: 1
+            })
         );
         let tiny_hole = [[1.0, 1.0], [2.0, 1.0]];
         assert_eq!(
             check(&SQUARE, &[&tiny_hole]),
-            Err(ShapeError::TooFewVertices { ring: RingRef::Hole(0), count: 2 })
+            Err(ShapeError::TooFewVertices {
+                ring: RingRef::Hole(0),
+                count: 2
+            })
         );
     }
 
     #[test]
     fn holes_outside_crossing_touching_or_nested() {
         let outside = [[20.0, 1.0], [21.0, 1.0], [21.0, 2.0]];
-        assert_eq!(check(&SQUARE, &[&outside]), Err(ShapeError::HoleOutside { hole: 0 }));
+        assert_eq!(
+            check(&SQUARE, &[&outside]),
+            Err(ShapeError::HoleOutside { hole: 0 })
+        );
         let crossing = [[9.0, 1.0], [11.0, 1.0], [11.0, 2.0], [9.0, 2.0]];
         assert_eq!(
             check(&SQUARE, &[&crossing]),
-            Err(ShapeError::HoleCrossesOuter { hole: 0, hole_edge: 0, outer_edge: 1 })
+            Err(ShapeError::HoleCrossesOuter {
+                hole: 0,
+                hole_edge: 0,
+                outer_edge: 1
+            })
         );
         let touching = [[10.0, 5.0], [9.0, 6.0], [9.0, 4.0]];
         assert!(matches!(
             check(&SQUARE, &[&touching]),
-            Err(ShapeError::HoleCrossesOuter { hole: 0, outer_edge: 1, .. })
+            Err(ShapeError::HoleCrossesOuter {
+                hole: 0,
+                outer_edge: 1,
+                ..
+            })
         ));
         let big = [[1.0, 1.0], [8.0, 1.0], [8.0, 8.0], [1.0, 8.0]];
         let small = [[3.0, 3.0], [4.0, 3.0], [4.0, 4.0]];
