@@ -8,12 +8,11 @@
 //! alpha shape's boundary follows the drawn edges instead of cutting notches into them.
 
 use super::error::FillError;
+use super::fill_boundary::{boundary_points, region_points};
 use super::index::Location;
 use super::overlap::validate_zones;
-use super::polygon::{cut_edges, Polygon};
-use super::segment::{self, Point};
+use super::segment::Point;
 use super::shape::Shape;
-use std::collections::BTreeMap;
 
 /// Lattice points closer than `DROP_FACTOR * h` to a zone's boundary are dropped.
 ///
@@ -60,6 +59,17 @@ pub struct FilledPoint {
     pub zone: usize,
     /// Whether it was placed on a zone boundary (rather than taken from the lattice).
     pub on_boundary: bool,
+    /// The local spacing: `FillParams::h`, or that of the finest fine region containing it.
+    pub h: f64,
+}
+
+/// A region filled at a finer spacing than the rest (`[[mesh.fine]]`). Where regions overlap
+/// the finest spacing wins. Its lattice is `anchor + h * (i, j)` too, so a spacing of
+/// `FillParams::h / 2^k` nests in the coarser lattice.
+#[derive(Debug, Clone)]
+pub struct FineRegion {
+    pub shape: Shape,
+    pub h: f64,
 }
 
 /// Fills `zones` (which must not overlap; they may touch) at spacing `params.h`.
@@ -73,16 +83,42 @@ pub struct FilledPoint {
 /// lexicographically smaller end, so both zones see bit-identical points. Boundary points
 /// within [`SNAP`]` * h` of a lattice node are put exactly on it.
 pub fn fill_zones(zones: &[Shape], params: &FillParams) -> Result<Vec<FilledPoint>, FillError> {
-    let h = params.h;
-    if !(h.is_finite() && h > 0.0) {
-        return Err(FillError::BadSpacing { h });
+    fill_zones_graded(zones, &[], params)
+}
+
+/// [`fill_zones`] with finer spacing inside `fine` regions. Each level (the base spacing and
+/// every distinct fine spacing) contributes the lattice points whose local spacing is its
+/// own, dropped within [`DROP_FACTOR`] of that spacing from a zone boundary or from the
+/// outline of a region at that spacing or finer; region outlines inside zones carry particles
+/// at the region's spacing, and zone boundary pieces are divided at the local spacing.
+pub fn fill_zones_graded(
+    zones: &[Shape],
+    fine: &[FineRegion],
+    params: &FillParams,
+) -> Result<Vec<FilledPoint>, FillError> {
+    let good = |h: f64| h.is_finite() && h > 0.0;
+    if !good(params.h) {
+        return Err(FillError::BadSpacing { h: params.h });
+    }
+    if let Some(r) = fine.iter().find(|r| !good(r.h) || r.h > params.h) {
+        return Err(FillError::BadSpacing { h: r.h });
     }
     if !(params.anchor[0].is_finite() && params.anchor[1].is_finite()) {
         return Err(FillError::BadAnchor {
             anchor: params.anchor,
         });
     }
-    let count: f64 = zones.iter().map(|z| lattice_range(z, params).count()).sum();
+    let mut levels: Vec<f64> = fine.iter().map(|r| r.h).chain([params.h]).collect();
+    levels.sort_by(f64::total_cmp);
+    levels.dedup();
+    let count: f64 = levels
+        .iter()
+        .flat_map(|&h| {
+            zones
+                .iter()
+                .map(move |z| lattice_range(z.bbox(), params.anchor, h).count())
+        })
+        .sum();
     if count > params.max_points as f64 {
         return Err(FillError::TooManyPoints {
             count,
@@ -91,23 +127,39 @@ pub fn fill_zones(zones: &[Shape], params: &FillParams) -> Result<Vec<FilledPoin
     }
     validate_zones(zones)?;
 
-    let mut points = boundary_points(zones, params);
-    for (z, shape) in zones.iter().enumerate() {
-        let r = lattice_range(shape, params);
-        for j in r.j0..=r.j1 {
-            for i in r.i0..=r.i1 {
-                let p = [
-                    params.anchor[0] + i as f64 * h,
-                    params.anchor[1] + j as f64 * h,
-                ];
-                if shape.locate(p) == Location::Inside
-                    && -shape.signed_distance(p) >= DROP_FACTOR * h
-                {
-                    points.push(FilledPoint {
-                        position: p,
-                        zone: z,
-                        on_boundary: false,
-                    });
+    let spacing = |p: Point| {
+        fine.iter()
+            .filter(|r| r.h < params.h && r.shape.contains(p))
+            .map(|r| r.h)
+            .fold(params.h, f64::min)
+    };
+    let mut points = boundary_points(zones, params, &spacing, levels[0]);
+    points.extend(region_points(zones, fine));
+    for &h in &levels {
+        // Outlines of regions at this spacing or finer carry particles (`region_points`).
+        let outlined: Vec<&FineRegion> = fine.iter().filter(|r| r.h <= h).collect();
+        for (z, shape) in zones.iter().enumerate() {
+            let r = lattice_range(shape.bbox(), params.anchor, h);
+            for j in r.j0..=r.j1 {
+                for i in r.i0..=r.i1 {
+                    let p = [
+                        params.anchor[0] + i as f64 * h,
+                        params.anchor[1] + j as f64 * h,
+                    ];
+                    let keep = shape.locate(p) == Location::Inside
+                        && -shape.signed_distance(p) >= DROP_FACTOR * h
+                        && spacing(p) == h
+                        && outlined
+                            .iter()
+                            .all(|f| f.shape.signed_distance(p).abs() >= DROP_FACTOR * h);
+                    if keep {
+                        points.push(FilledPoint {
+                            position: p,
+                            zone: z,
+                            on_boundary: false,
+                            h,
+                        });
+                    }
                 }
             }
         }
@@ -143,109 +195,14 @@ impl LatticeRange {
     }
 }
 
-fn lattice_range(shape: &Shape, params: &FillParams) -> LatticeRange {
-    let [lo, hi] = shape.bbox();
-    let (a, h) = (params.anchor, params.h);
+fn lattice_range(bbox: [Point; 2], anchor: Point, h: f64) -> LatticeRange {
+    let [lo, hi] = bbox;
     // Saturating float-to-int casts keep absurd inputs finite; the count check refuses them.
     let idx = |x: f64| x.clamp(-4e18, 4e18) as i64;
     LatticeRange {
-        i0: idx(((lo[0] - a[0]) / h).ceil()),
-        i1: idx(((hi[0] - a[0]) / h).floor()),
-        j0: idx(((lo[1] - a[1]) / h).ceil()),
-        j1: idx(((hi[1] - a[1]) / h).floor()),
+        i0: idx(((lo[0] - anchor[0]) / h).ceil()),
+        i1: idx(((hi[0] - anchor[0]) / h).floor()),
+        j0: idx(((lo[1] - anchor[1]) / h).ceil()),
+        j1: idx(((hi[1] - anchor[1]) / h).floor()),
     }
-}
-
-type Key = ([u64; 2], [u64; 2]);
-
-fn key(p: Point) -> [u64; 2] {
-    p.map(f64::to_bits)
-}
-
-/// Lexicographic order on points (x, then y).
-fn lex_less(a: Point, b: Point) -> bool {
-    a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])).is_lt()
-}
-
-/// Boundary points within this many spacings of a lattice node are moved onto it.
-pub const SNAP: f64 = 1e-9;
-
-/// `p`, or the lattice node it lies within [`SNAP`]` * h` of in both coordinates. Edges on
-/// lattice lines then give exactly the lattice's own coordinates, so a rectangle anchored on
-/// the lattice is filled bit for bit as the plain lattice was.
-fn snap(p: Point, params: &FillParams) -> Point {
-    let (a, h) = (params.anchor, params.h);
-    let node = |x: f64, o: f64| {
-        let i = ((x - o) / h).round();
-        let q = o + i * h;
-        ((q - x).abs() <= SNAP * h).then_some(q)
-    };
-    match (node(p[0], a[0]), node(p[1], a[1])) {
-        (Some(x), Some(y)) => [x, y],
-        _ => p,
-    }
-}
-
-fn boundary_points(zones: &[Shape], params: &FillParams) -> Vec<FilledPoint> {
-    let h = params.h;
-    let polygons: Vec<(usize, &Polygon)> = zones
-        .iter()
-        .enumerate()
-        .filter_map(|(z, s)| s.as_polygon().map(|p| (z, p)))
-        .collect();
-    // Each distinct piece, from its smaller end, with the lowest zone that has it.
-    let mut pieces: BTreeMap<Key, (Point, Point, usize)> = BTreeMap::new();
-    for &(z, p) in &polygons {
-        let others: Vec<&Polygon> = polygons
-            .iter()
-            .filter(|&&(y, q)| y != z && boxes_touch(p.bbox(), q.bbox()))
-            .map(|&(_, q)| q)
-            .collect();
-        for [a, b] in cut_edges(p, &others) {
-            let (a, b) = if lex_less(b, a) { (b, a) } else { (a, b) };
-            let e = pieces.entry((key(a), key(b))).or_insert((a, b, z));
-            e.2 = e.2.min(z);
-        }
-    }
-    let mut owner: BTreeMap<[u64; 2], (Point, usize)> = BTreeMap::new();
-    let mut put = |p: Point, z: usize| {
-        let p = snap(p, params);
-        let e = owner.entry(key(p)).or_insert((p, z));
-        e.1 = e.1.min(z);
-    };
-    for &(a, b, z) in pieces.values() {
-        let n = divisions(segment::length(a, b), h);
-        put(a, z);
-        put(b, z);
-        for k in 1..n {
-            let t = k as f64 / n as f64;
-            put([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])], z);
-        }
-    }
-    for (z, s) in zones.iter().enumerate() {
-        if let Shape::Circle(c) = s {
-            let n = c.arcs(h);
-            for k in 0..n {
-                put(c.point(k, n), z);
-            }
-        }
-    }
-    owner
-        .into_values()
-        .map(|(position, zone)| FilledPoint {
-            position,
-            zone,
-            on_boundary: true,
-        })
-        .collect()
-}
-
-/// Equal parts of length at most `h`; the small allowance keeps an edge of exactly `k h`
-/// from getting `k + 1` parts through rounding.
-fn divisions(len: f64, h: f64) -> usize {
-    ((len / h - 1e-9).ceil() as usize).max(1)
-}
-
-fn boxes_touch(a: [Point; 2], b: [Point; 2]) -> bool {
-    a[0][0] <= b[1][0] && b[0][0] <= a[1][0] && a[0][1] <= b[1][1] && b[0][1] <= a[1][1]
 }

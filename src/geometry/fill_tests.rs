@@ -2,7 +2,10 @@
 //! alpha shape (alpha 1.3, the scene default) of the generated cloud, compared with the drawn
 //! zones.
 
-use super::fill::{fill_zones, FillParams, FilledPoint, DROP_FACTOR, SNAP};
+use super::fill::{
+    fill_zones, fill_zones_graded, FillParams, FilledPoint, FineRegion, DROP_FACTOR,
+};
+use super::fill_boundary::SNAP;
 use super::index::Location;
 use super::polygon::Polygon;
 use super::segment::{self, orient, Point};
@@ -32,7 +35,8 @@ fn recovery(zones: &[Shape], pts: &[FilledPoint], h: f64) -> Recovery {
     let xy: Vec<Point> = pts.iter().map(|p| p.position).collect();
     let ids: Vec<u64> = (0..xy.len() as u64).collect();
     let tris = delaunay(&xy, &ids).expect("triangulation");
-    let keep = alpha_keep(&xy, &tris, &vec![h; xy.len()], ALPHA);
+    let hs: Vec<f64> = pts.iter().map(|p| p.h).collect();
+    let keep = alpha_keep(&xy, &tris, &hs, ALPHA);
     let kept: Vec<[u32; 3]> = tris
         .iter()
         .zip(&keep)
@@ -375,4 +379,67 @@ fn a_rectangle_on_the_anchor_gives_the_plain_lattice() {
         let (i, j) = (k % 13, k / 13);
         assert_eq!(p.position, [0.1 + i as f64 * h, 0.7 + j as f64 * h]);
     }
+}
+
+#[test]
+fn graded_fill_around_a_fine_polygon_region() {
+    // A block with a fine quadrilateral under a footing at its top, at h / 4.
+    let h = 0.5;
+    let block = poly(&[[0.0, 0.0], [12.0, 0.0], [12.0, 6.0], [0.0, 6.0]], vec![]);
+    let region = FineRegion {
+        shape: poly(&[[4.0, 6.0], [4.5, 4.0], [7.5, 4.0], [8.0, 6.0]], vec![]),
+        h: h / 4.0,
+    };
+    let zones = [block];
+    let pts = fill_zones_graded(
+        &zones,
+        std::slice::from_ref(&region),
+        &FillParams::new(h, [0.0, 0.0]),
+    )
+    .unwrap();
+    // Fine particles exactly in the region or on its outline (to rounding); coarse ones at
+    // least h / 2 away from it.
+    for p in &pts {
+        let inside = region.shape.signed_distance(p.position) <= 1e-12;
+        assert_eq!(p.h, if inside { h / 4.0 } else { h }, "{p:?}");
+        if !inside && !p.on_boundary {
+            assert!(region.shape.signed_distance(p.position) >= 0.5 * h);
+        }
+    }
+    let fine = pts.iter().filter(|p| p.h < h).count() as f64;
+    let expect = region.shape.area() / (h / 4.0).powi(2);
+    assert!(
+        (fine / expect - 1.0).abs() < 0.15,
+        "{fine} fine particles, about {expect} expected"
+    );
+    // The seabed inside the region is lined at the fine spacing.
+    let top_fine = pts
+        .iter()
+        .filter(|p| p.position[1] == 6.0 && (4.0..=8.0).contains(&p.position[0]))
+        .count();
+    assert_eq!(top_fine, 33);
+    let r = recovery(&zones, &pts, h);
+    eprintln!(
+        "graded: {} particles ({fine} fine), area error {:.2e}, max R/h {:.3}",
+        pts.len(),
+        area_error(&r),
+        r.max_circumradius_over_h
+    );
+    assert!(r.spurious.is_empty(), "{:?}", r.spurious);
+    assert!(r.off_boundary.is_empty(), "{:?}", r.off_boundary);
+    assert!(area_error(&r) < 1e-12);
+    // Without regions the graded fill is the plain one.
+    let params = FillParams::new(h, [0.0, 0.0]);
+    assert_eq!(
+        fill_zones_graded(&zones, &[], &params).unwrap(),
+        fill_zones(&zones, &params).unwrap()
+    );
+    let coarse_region = FineRegion {
+        shape: region.shape.clone(),
+        h: 2.0 * h,
+    };
+    assert_eq!(
+        fill_zones_graded(&zones, &[coarse_region], &params),
+        Err(FillError::BadSpacing { h: 2.0 * h })
+    );
 }

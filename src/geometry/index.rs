@@ -455,3 +455,73 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod exact_tests {
+    use super::*;
+
+    /// Reference point location: boundary by exact on-segment tests, otherwise the crossing
+    /// number of a ray to the right with the half-open rule (exact: it only compares y and
+    /// uses orient for the side).
+    fn brute(segs: &[[Point; 2]], p: Point) -> Location {
+        if segs.iter().any(|s| segment::on_segment(s[0], s[1], p)) {
+            return Location::Boundary;
+        }
+        let mut inside = false;
+        for &[a, b] in segs {
+            let (lo, hi) = if a[1] <= b[1] { (a, b) } else { (b, a) };
+            if lo[1] <= p[1] && p[1] < hi[1] && orient(lo, hi, p) > 0.0 {
+                inside = !inside;
+            }
+        }
+        if inside {
+            Location::Inside
+        } else {
+            Location::Outside
+        }
+    }
+
+    #[test]
+    fn integer_polygon_with_hole_at_every_grid_and_half_grid_point() {
+        // A staircase with a diagonal edge and a hole whose vertices share rows and columns
+        // with the outer ring: queries at integer points hit vertices and edges constantly.
+        let outer = [
+            [0.0, 0.0],
+            [8.0, 0.0],
+            [8.0, 2.0],
+            [6.0, 2.0],
+            [6.0, 4.0],
+            [8.0, 6.0],
+            [0.0, 6.0],
+            [0.0, 4.0],
+            [2.0, 4.0],
+            [2.0, 2.0],
+            [0.0, 2.0],
+        ];
+        let hole = [
+            [3.0, 1.0],
+            [3.0, 5.0],
+            [5.0, 5.0],
+            [5.0, 3.0],
+            [4.0, 2.0],
+            [5.0, 1.0],
+        ];
+        let mut segs: Vec<[Point; 2]> = Vec::new();
+        for ring in [&outer[..], &hole[..]] {
+            for k in 0..ring.len() {
+                segs.push([ring[k], ring[(k + 1) % ring.len()]]);
+            }
+        }
+        let loc = Locator::new(segs.clone());
+        let mut counts = [0usize; 3];
+        for i in -2..=36 {
+            for j in -2..=28 {
+                let p = [i as f64 * 0.25, j as f64 * 0.25];
+                let want = brute(&segs, p);
+                assert_eq!(loc.locate(p), want, "at {p:?}");
+                counts[want as usize] += 1;
+            }
+        }
+        assert!(counts.iter().all(|&c| c > 100), "{counts:?}");
+    }
+}

@@ -22,6 +22,7 @@
 
 mod error;
 mod fill;
+mod fill_boundary;
 #[cfg(test)]
 mod fill_tests;
 mod gmsh;
@@ -37,7 +38,11 @@ mod shape;
 mod validate;
 
 pub use error::{FillError, RingRef, ShapeError, ZonesOverlap};
-pub use fill::{fill_shape, fill_zones, FillParams, FilledPoint, DEFAULT_MAX_POINTS, DROP_FACTOR};
+pub use fill::{
+    fill_shape, fill_zones, fill_zones_graded, FillParams, FilledPoint, FineRegion,
+    DEFAULT_MAX_POINTS, DROP_FACTOR,
+};
+pub use fill_boundary::SNAP;
 pub use gmsh::{
     parse_msh, read_msh, GmshError, GmshErrorKind, GmshMesh, GmshNode, PhysicalCurve,
     PhysicalSurface,
