@@ -254,6 +254,12 @@ fn refusals_name_the_file_and_the_reason() {
     let unknown =
         tiny(0.0, &[1], "", false).replace("1 1 2 3\n$EndElements", "1 1 2 9\n$EndElements");
     assert_eq!(kind(&unknown), GmshErrorKind::UnknownNode { node: 9 });
+    let infinite = tiny(0.0, &[1], "", false).replace("\n1 0 0\n", "\ninf 0 0\n");
+    assert!(
+        matches!(kind(&infinite), GmshErrorKind::Damaged { .. }),
+        "{:?}",
+        kind(&infinite)
+    );
     // mshio unwraps the data-size field and would panic on this one.
     let huge = "$MeshFormat\n4.1 0 99999999999999999999999\n$EndMeshFormat\n";
     assert!(matches!(kind(huge), GmshErrorKind::Damaged { .. }));

@@ -27,6 +27,7 @@ mod fill_boundary;
 mod fill_tests;
 mod gmsh;
 mod gmsh_header;
+mod gmsh_import;
 #[cfg(test)]
 mod gmsh_tests;
 mod index;
