@@ -143,9 +143,10 @@ fn poly(outer: &[Point], holes: Vec<Vec<Point>>) -> Shape {
 
 #[test]
 fn polygon_with_hole_recovers_its_area_boundary_and_hole() {
-    // A site with a sloping top and a tunnel (a circular hole drawn as a ring at spacing h).
-    let h = 0.5;
+    // A site with a sloping top and a tunnel (a circular hole drawn as a ring at spacing h),
+    // then also a tilted square cavity, at two spacings, with the lattice aligned and not.
     let tunnel = Circle::new([8.0, 4.5], 2.0).unwrap();
+    let cavity = vec![[14.0, 3.0], [16.0, 4.0], [15.0, 6.0], [13.0, 5.0]];
     let outer = [
         [0.0, 0.0],
         [20.0, 0.0],
@@ -153,31 +154,64 @@ fn polygon_with_hole_recovers_its_area_boundary_and_hole() {
         [12.0, 10.0],
         [0.0, 10.0],
     ];
-    let zone = poly(&outer, vec![tunnel.ring(h)]);
-    let zones = [zone];
+    for (h, anchor) in [(0.5, [0.0, 0.0]), (0.5, [0.13, 0.37]), (0.25, [0.0, 0.0])] {
+        for with_cavity in [false, true] {
+            let mut holes = vec![tunnel.ring(h)];
+            if with_cavity {
+                holes.push(cavity.clone());
+            }
+            let zones = [poly(&outer, holes.clone())];
+            let pts = fill_zones(&zones, &FillParams::new(h, anchor)).unwrap();
+            check_placement(&zones, &pts, h);
+            check_edge_spacing(&zones[0], &pts, h);
+            // The holes stay open: no particle inside them (boundary particles may be snapped
+            // onto a lattice node by up to SNAP h).
+            for hole in &holes {
+                let hole = poly(hole, vec![]);
+                for p in &pts {
+                    let depth = -hole.signed_distance(p.position);
+                    assert!(depth <= SNAP * h, "{p:?} is {depth} inside a hole");
+                }
+            }
+            let r = recovery(&zones, &pts, h);
+            eprintln!(
+                "polygon with {} holes, h = {h}, anchor {anchor:?}: {} particles, mesh area \
+                 {:.12} vs {:.12} (relative error {:.2e}), max R/h {:.3}, min distance/h {:.3}",
+                holes.len(),
+                pts.len(),
+                r.mesh_area,
+                r.zone_area,
+                area_error(&r),
+                r.max_circumradius_over_h,
+                r.min_distance_over_h
+            );
+            assert!(area_error(&r) < 0.005);
+            if !with_cavity {
+                assert!(r.spurious.is_empty(), "h = {h}: {:?}", r.spurious);
+                assert!(r.off_boundary.is_empty(), "h = {h}: {:?}", r.off_boundary);
+                assert_eq!(r.buried, 0);
+                assert!(area_error(&r) < 1e-12);
+                continue;
+            }
+            // The cavity's four corners are re-entrant right angles for the body: each is cut
+            // by one triangle (see `reentrant_right_angle_is_cut_by_exactly_one_corner_triangle`),
+            // and nothing else is.
+            assert_eq!(r.spurious.len(), 4, "{:?}", r.spurious);
+            for t in &r.spurious {
+                assert!(t.iter().any(|v| cavity.contains(v)), "{t:?}");
+            }
+            assert_eq!(r.off_boundary.len(), 4);
+            assert_eq!(r.buried, 4);
+        }
+    }
+    // The resolution limit: at h = 1 the cavity (2.2 h across, circumradius 1.58 h) is
+    // spanned by small triangles between its own boundary particles and closes, while the
+    // tunnel (radius 2 h > 1.3 h) stays open.
+    let h = 1.0;
+    let zones = [poly(&outer, vec![tunnel.ring(h), cavity.clone()])];
     let pts = fill_zones(&zones, &FillParams::new(h, [0.0, 0.0])).unwrap();
-    check_placement(&zones, &pts, h);
-    check_edge_spacing(&zones[0], &pts, h);
-    // The hole stays open: no particle inside it.
-    let hole = poly(&tunnel.ring(h), vec![]);
-    assert!(pts
-        .iter()
-        .all(|p| hole.locate(p.position) != Location::Inside));
     let r = recovery(&zones, &pts, h);
-    eprintln!(
-        "polygon with hole, h = {h}: {} particles, mesh area {:.12} vs {:.12} (relative error \
-         {:.2e}), max R/h {:.3}, min distance/h {:.3}",
-        pts.len(),
-        r.mesh_area,
-        r.zone_area,
-        area_error(&r),
-        r.max_circumradius_over_h,
-        r.min_distance_over_h
-    );
-    assert!(area_error(&r) < 0.005);
-    assert!(r.spurious.is_empty(), "{:?}", r.spurious);
-    assert!(r.off_boundary.is_empty(), "{:?}", r.off_boundary);
-    assert_eq!(r.buried, 0);
+    assert!((r.mesh_area - r.zone_area - 5.0).abs() < 1e-9, "{r:?}");
 }
 
 #[test]
