@@ -9,7 +9,7 @@
 
 use super::error::FillError;
 use super::fill_boundary::{boundary_points, region_points};
-use super::index::Location;
+use super::locate::Location;
 use super::overlap::validate_zones;
 use super::segment::Point;
 use super::shape::Shape;

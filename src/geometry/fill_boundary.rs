@@ -2,7 +2,7 @@
 //! sharing a boundary see bit-identical particles, each owned by the lowest zone.
 
 use super::fill::{FillParams, FilledPoint, FineRegion, DROP_FACTOR};
-use super::index::Location;
+use super::locate::Location;
 use super::polygon::{cut_edges, Polygon};
 use super::segment::{self, Point};
 use super::shape::Shape;

@@ -6,7 +6,7 @@ use super::fill::{
     fill_zones, fill_zones_graded, FillParams, FilledPoint, FineRegion, DROP_FACTOR,
 };
 use super::fill_boundary::SNAP;
-use super::index::Location;
+use super::locate::Location;
 use super::polygon::Polygon;
 use super::segment::{self, orient, Point};
 use super::shape::{Circle, Rectangle, Shape};

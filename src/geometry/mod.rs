@@ -20,6 +20,7 @@
 //! that touch must share coordinates exactly along the shared part (always true for shared
 //! vertices).
 
+mod bvh;
 mod error;
 mod fill;
 mod fill_boundary;
@@ -31,6 +32,7 @@ mod gmsh_import;
 #[cfg(test)]
 mod gmsh_tests;
 mod index;
+mod locate;
 mod overlap;
 mod polygon;
 mod segment;
@@ -48,7 +50,7 @@ pub use gmsh::{
     parse_msh, read_msh, GmshError, GmshErrorKind, GmshMesh, GmshNode, PhysicalCurve,
     PhysicalSurface,
 };
-pub use index::Location;
+pub use locate::Location;
 pub use overlap::{overlap, validate_zones};
 pub use polygon::{Polygon, Segment};
 pub use segment::Point;

@@ -8,7 +8,7 @@
 //! tangent circles touch rather than overlap.
 
 use super::error::ZonesOverlap;
-use super::index::Location;
+use super::locate::Location;
 use super::polygon::{cut_edges, Polygon};
 use super::segment::{self, Contact, Point};
 use super::shape::{Circle, Shape};

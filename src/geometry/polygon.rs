@@ -1,7 +1,9 @@
 //! Simple polygons with holes, validated once and indexed for constant-time queries.
 
+use super::bvh::SegmentTree;
 use super::error::{RingRef, ShapeError};
-use super::index::{EdgeGrid, Location, Locator};
+use super::index::EdgeGrid;
+use super::locate::{Location, Locator};
 use super::segment::{self, Point};
 use super::validate::{check_rings, is_ccw, open_ring, ring_segments};
 
@@ -29,6 +31,7 @@ pub struct Polygon {
     names: Vec<Vec<Option<String>>>,
     input_edge: Vec<Vec<usize>>,
     locator: Locator,
+    tree: SegmentTree,
     area: f64,
     bbox: [Point; 2],
 }
@@ -99,6 +102,7 @@ impl Polygon {
             rings,
             names,
             input_edge,
+            tree: SegmentTree::new(segs.clone()),
             locator: Locator::new(segs),
             area,
             bbox,
@@ -131,10 +135,7 @@ impl Polygon {
 
     /// Distance from `p` to the nearest edge of any ring.
     pub fn boundary_distance(&self, p: Point) -> f64 {
-        self.locator
-            .grid()
-            .nearest(p)
-            .map_or(f64::INFINITY, |(d, _)| d)
+        self.tree.nearest(p).map_or(f64::INFINITY, |(d, _)| d)
     }
 
     /// Distance to the boundary, negative inside, zero on it.
@@ -311,9 +312,9 @@ mod tests {
         );
     }
 
-    #[test]
-    fn a_thousand_vertex_polygon_answers_ten_thousand_queries_fast() {
-        let n = 1000;
+    /// A wavy disc of `n` vertices, its build time, and the fastest of three passes of 10k
+    /// `contains` + 10k `signed_distance` queries over its bounding square.
+    fn timed_queries(n: usize) -> (Polygon, std::time::Duration, std::time::Duration, usize) {
         let outer: Vec<Point> = (0..n)
             .map(|k| {
                 let t = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
@@ -322,7 +323,7 @@ mod tests {
             })
             .collect();
         let start = std::time::Instant::now();
-        let p = Polygon::new(outer.clone(), vec![]).unwrap();
+        let p = Polygon::new(outer, vec![]).unwrap();
         let built = start.elapsed();
         let queries: Vec<Point> = (0..10_000)
             .map(|k| {
@@ -330,22 +331,40 @@ mod tests {
                 [24.0 * (t.fract() - 0.5), 24.0 * ((t * 7.1).fract() - 0.5)]
             })
             .collect();
-        let start = std::time::Instant::now();
-        let mut inside = 0usize;
-        let mut dist = 0.0;
-        for &q in &queries {
-            inside += p.contains(q) as usize;
-            dist += p.signed_distance(q);
+        let mut fastest = std::time::Duration::MAX;
+        let mut inside = 0;
+        for _ in 0..3 {
+            let start = std::time::Instant::now();
+            inside = 0;
+            let mut dist = 0.0;
+            for &q in &queries {
+                inside += p.contains(q) as usize;
+                dist += p.signed_distance(q);
+            }
+            std::hint::black_box(dist);
+            fastest = fastest.min(start.elapsed());
         }
-        let queried = start.elapsed();
+        (p, built, fastest, inside)
+    }
+
+    #[test]
+    fn query_cost_does_not_grow_with_the_vertex_count() {
+        let (p, built, small, inside) = timed_queries(1000);
+        let (_, built_big, big, _) = timed_queries(16_000);
         eprintln!(
-            "1000-vertex polygon: built in {built:?}; 10k contains + 10k signed_distance in \
-             {queried:?} ({inside} inside, mean distance {:.3})",
-            dist / 1e4
+            "10k contains + 10k signed_distance: 1000 vertices {small:?} (built in {built:?}), \
+             16000 vertices {big:?} (built in {built_big:?})"
         );
-        // The area inside, from the queries, must match the polygon's to sampling accuracy.
+        // The area inside, from the queries, matches the polygon's to sampling accuracy.
         let frac = inside as f64 / 1e4;
         assert!((frac * 24.0 * 24.0 - p.area()).abs() / p.area() < 0.05);
-        assert!(queried.as_secs_f64() < 0.5, "{queried:?}");
+        // Sixteen times the vertices: a linear search would take sixteen times as long. Both
+        // timings are the fastest of three, which keeps a loaded machine from deciding.
+        let ratio = big.as_secs_f64() / small.as_secs_f64();
+        assert!(
+            ratio < 6.0,
+            "{ratio:.1} times slower with 16 times the vertices"
+        );
+        assert!(small.as_secs_f64() < 5.0, "{small:?}");
     }
 }

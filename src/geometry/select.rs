@@ -1,8 +1,8 @@
 //! Named boundaries (polygon edges named in a scene, Gmsh physical curves) and selecting
 //! points on them, for `on = "seabed"` selections.
 
+use super::bvh::SegmentTree;
 use super::gmsh::GmshMesh;
-use super::index::EdgeGrid;
 use super::segment::Point;
 use super::shape::Shape;
 use std::collections::BTreeMap;
@@ -31,7 +31,7 @@ impl std::error::Error for UnknownBoundary {}
 /// Segments grouped by name, each group indexed for distance queries.
 #[derive(Debug, Clone, Default)]
 pub struct NamedBoundaries {
-    by_name: BTreeMap<String, EdgeGrid>,
+    by_name: BTreeMap<String, SegmentTree>,
 }
 
 impl NamedBoundaries {
@@ -45,7 +45,7 @@ impl NamedBoundaries {
         NamedBoundaries {
             by_name: groups
                 .into_iter()
-                .map(|(n, s)| (n, EdgeGrid::new(s)))
+                .map(|(n, s)| (n, SegmentTree::new(s)))
                 .collect(),
         }
     }
@@ -56,8 +56,8 @@ impl NamedBoundaries {
 
     /// Distance from `p` to the boundary `name`.
     pub fn distance(&self, name: &str, p: Point) -> Result<f64, UnknownBoundary> {
-        let grid = self.grid(name)?;
-        Ok(grid.nearest(p).map_or(f64::INFINITY, |(d, _)| d))
+        let tree = self.tree(name)?;
+        Ok(tree.nearest(p).map_or(f64::INFINITY, |(d, _)| d))
     }
 
     /// Indices of the `points` within `tol` of the boundary `name`, ascending. Particles placed
@@ -69,13 +69,13 @@ impl NamedBoundaries {
         points: &[Point],
         tol: f64,
     ) -> Result<Vec<usize>, UnknownBoundary> {
-        let grid = self.grid(name)?;
+        let tree = self.tree(name)?;
         Ok((0..points.len())
-            .filter(|&k| grid.nearest(points[k]).is_some_and(|(d, _)| d <= tol))
+            .filter(|&k| tree.nearest(points[k]).is_some_and(|(d, _)| d <= tol))
             .collect())
     }
 
-    fn grid(&self, name: &str) -> Result<&EdgeGrid, UnknownBoundary> {
+    fn tree(&self, name: &str) -> Result<&SegmentTree, UnknownBoundary> {
         self.by_name.get(name).ok_or_else(|| UnknownBoundary {
             name: name.to_string(),
             known: self.by_name.keys().cloned().collect(),

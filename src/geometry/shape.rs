@@ -1,7 +1,7 @@
 //! The shapes a zone can take, behind one enum.
 
 use super::error::{RingRef, ShapeError};
-use super::index::Location;
+use super::locate::Location;
 use super::polygon::{Polygon, Segment};
 use super::segment::Point;
 use std::f64::consts::PI;

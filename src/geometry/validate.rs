@@ -2,7 +2,8 @@
 //! never makes containment or filling ambiguous.
 
 use super::error::{RingRef, ShapeError};
-use super::index::{EdgeGrid, Location, Locator};
+use super::index::EdgeGrid;
+use super::locate::{Location, Locator};
 use super::segment::{self, orient, Contact, Point};
 
 fn ring_ref(k: usize) -> RingRef {
