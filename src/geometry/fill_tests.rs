@@ -477,3 +477,49 @@ fn graded_fill_around_a_fine_polygon_region() {
         Err(FillError::BadSpacing { h: 2.0 * h })
     );
 }
+
+#[test]
+fn random_star_polygons_fill_with_particles_in_place_and_once() {
+    let mut state = 0x0dd_b1a5_e5u64;
+    let mut u = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for _ in 0..40 {
+        let n = 3 + (u() * 30.0) as usize;
+        let outer: Vec<Point> = (0..n)
+            .map(|k| {
+                let t = 2.0 * std::f64::consts::PI * (k as f64 + 0.8 * u()) / n as f64;
+                let r = 1.0 + 4.0 * u();
+                [r * t.cos(), r * t.sin()]
+            })
+            .collect();
+        let h = 0.1 + 0.3 * u();
+        let zones = [poly(&outer, vec![])];
+        let pts = fill_zones(&zones, &FillParams::new(h, [u(), u()])).unwrap();
+        check_placement(&zones, &pts, h);
+        check_edge_spacing_upper(&zones[0], &pts, h);
+    }
+}
+
+/// Consecutive boundary particles along each edge are at most h apart (edges shorter than
+/// h / 2 make closer ones, which is the drawing's detail, not the fill's).
+fn check_edge_spacing_upper(shape: &Shape, pts: &[FilledPoint], h: f64) {
+    for s in shape.boundary(h) {
+        let mut along: Vec<f64> = pts
+            .iter()
+            .filter(|p| p.on_boundary && segment::distance(s.a, s.b, p.position) <= 1e-9 * h)
+            .map(|p| segment::length(s.a, p.position))
+            .collect();
+        along.sort_by(f64::total_cmp);
+        for w in along.windows(2) {
+            assert!(
+                w[1] - w[0] <= h * (1.0 + 1e-9),
+                "gap {} on {s:?}",
+                w[1] - w[0]
+            );
+        }
+    }
+}

@@ -311,3 +311,60 @@ mod tests {
         assert!(!is_ccw(&[sliver[0], sliver[2], sliver[1]]));
     }
 }
+
+#[cfg(test)]
+mod property_tests {
+    use super::*;
+
+    /// Whether a ring is simple, by testing every pair of edges.
+    fn brute_simple(ring: &[Point]) -> bool {
+        let n = ring.len();
+        for s in 0..n {
+            for t in s + 1..n {
+                let (a, b) = (ring[s], ring[(s + 1) % n]);
+                let (c, d) = (ring[t], ring[(t + 1) % n]);
+                let adjacent = t == s + 1 || (s == 0 && t == n - 1);
+                let bad = if adjacent {
+                    segment::collinear_overlap(a, b, c, d)
+                } else {
+                    segment::contact(a, b, c, d) != Contact::Disjoint
+                };
+                if bad {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    #[test]
+    fn random_rings_on_a_small_grid_match_an_all_pairs_check() {
+        // Vertices on a 5 x 5 grid: collinear runs, touching vertices and spikes are common.
+        let mut state = 0x1234_5678_9abc_def0u64;
+        let mut next = |n: u64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) % n
+        };
+        let (mut accepted, mut refused) = (0, 0);
+        for _ in 0..20_000 {
+            let n = 3 + next(6) as usize;
+            let ring: Vec<Point> = (0..n).map(|_| [next(5) as f64, next(5) as f64]).collect();
+            let got = check_rings(std::slice::from_ref(&ring));
+            let degenerate = (0..n).any(|i| ring[i] == ring[(i + 1) % n])
+                || ring.iter().all(|&p| orient(ring[0], ring[1], p) == 0.0);
+            let want = !degenerate && brute_simple(&ring);
+            assert_eq!(got.is_ok(), want, "{ring:?}: {got:?}");
+            if want {
+                accepted += 1;
+            } else {
+                refused += 1;
+            }
+        }
+        assert!(
+            accepted > 1000 && refused > 1000,
+            "{accepted} accepted, {refused} refused"
+        );
+    }
+}
