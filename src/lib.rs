@@ -8,6 +8,7 @@ pub mod case_file;
 pub mod cli;
 pub mod commands;
 pub mod fem;
+pub mod geometry;
 pub mod heap;
 pub mod history;
 pub mod mapping;
