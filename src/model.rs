@@ -4,7 +4,8 @@ use crate::material::elastic::LinearElastic;
 use crate::material::tresca::{CuProfile, Tresca};
 use crate::material::{Material, StateLayout};
 use crate::rigid::RigidBody;
-use crate::scene::{Axis, ElementChoice, MaterialModel, Prescribed, Scene, Selection};
+use crate::geometry::NamedBoundaries;
+use crate::scene::{Axis, ElementChoice, Fixed, MaterialModel, Prescribed, Scene, Selection};
 use crate::solve::Kernel;
 
 /// The layout of the state rows of a scene's material: what case files, checkpoints and output
@@ -40,6 +41,18 @@ pub fn material_of(scene: &Scene) -> Result<Box<dyn Material>, String> {
     })
 }
 
+/// The named edges of a scene's zones (empty for a body of rectangles).
+pub fn named_boundaries(scene: &Scene) -> NamedBoundaries {
+    let shapes = crate::scene::zones::shapes(scene).unwrap_or_default();
+    NamedBoundaries::from_segments(crate::geometry::zone_segments(&shapes, scene.mesh.h))
+}
+
+/// Whether `x0` lies on boundary `name` of `b`: the fill puts particles on the edges to within
+/// rounding, so 1e-6 of the spacing `h` picks exactly them.
+pub fn on_boundary(b: &NamedBoundaries, name: &str, x0: [f64; 2], h: f64) -> bool {
+    b.distance(name, x0).is_ok_and(|d| d <= 1e-6 * h)
+}
+
 pub struct Model {
     pub material: Box<dyn Material>,
     pub kernel: Kernel,
@@ -48,6 +61,8 @@ pub struct Model {
     pub tol: f64,
     /// The `[[rigid]]` bodies, in scene order.
     pub bodies: Vec<RigidBody>,
+    /// The named zone edges that `on =` selections pick.
+    pub boundaries: NamedBoundaries,
     pub scene: Scene,
 }
 
@@ -84,6 +99,7 @@ impl Model {
             bodies.push(RigidBody::new(r, shape, m.cu, scene.steps.count));
         }
         Ok(Model {
+            boundaries: named_boundaries(scene),
             bodies,
             material,
             kernel,
@@ -130,7 +146,7 @@ impl Model {
     pub fn step_bc(&self, x0: [f64; 2], x: [f64; 2], from: f64, to: f64) -> [Option<f64>; 2] {
         let mut bc = [None, None];
         for f in &self.scene.fixed {
-            if f.region.matches(x0, self.tol) {
+            if self.fixes(f, x0) {
                 for d in &f.dofs {
                     bc[d.index()] = Some(0.0);
                 }
@@ -168,7 +184,7 @@ impl Model {
     pub fn in_set(&self, set: usize, x0: [f64; 2], x: [f64; 2], lambda: f64) -> bool {
         let nf = self.scene.fixed.len();
         if set < nf {
-            self.scene.fixed[set].region.matches(x0, self.tol)
+            self.fixes(&self.scene.fixed[set], x0)
         } else {
             self.scene
                 .prescribed
@@ -177,9 +193,21 @@ impl Model {
         }
     }
 
+    /// Whether `[[fixed]]` entry `f` holds a particle starting at `x0`.
+    fn fixes(&self, f: &Fixed, x0: [f64; 2]) -> bool {
+        f.region.matches(x0, self.tol) && self.on(f.on.as_deref(), x0)
+    }
+
+    /// Whether `x0` lies on the named boundary (true without a name).
+    fn on(&self, name: Option<&str>, x0: [f64; 2]) -> bool {
+        name.is_none_or(|n| on_boundary(&self.boundaries, n, x0, self.scene.mesh.h))
+    }
+
     fn selects(&self, p: &Prescribed, x0: [f64; 2], x: [f64; 2], lambda: f64) -> bool {
         match p.select {
-            Selection::Initial => p.region.matches(x0, self.tol),
+            Selection::Initial => {
+                p.region.matches(x0, self.tol) && self.on(p.on.as_deref(), x0)
+            }
             Selection::Current => {
                 let mut back = x;
                 for d in &p.dofs {

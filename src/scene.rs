@@ -72,6 +72,7 @@ mod validate_fine;
 pub mod validate_rigid;
 #[path = "scene/validate_supports.rs"]
 mod validate_supports;
+pub mod zones;
 #[path = "scene/value_de.rs"]
 mod value_de;
 
@@ -177,9 +178,9 @@ impl Scene {
         toml::to_string(self).expect("a Scene always has a TOML representation")
     }
 
-    /// `[[xmin, ymin], [xmax, ymax]]` of the body rectangles.
+    /// `[[xmin, ymin], [xmax, ymax]]` of the body rectangles and zones.
     pub fn bounding_box(&self) -> [[f64; 2]; 2] {
-        let empty = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
+        let empty = zones::bounding_box(&self.body.zones);
         self.body.rectangles.iter().fold(empty, |[lo, hi], r| {
             let top = [r.origin[0] + r.size[0], r.origin[1] + r.size[1]];
             [

@@ -160,3 +160,152 @@ fn a_coarse_vertical_cut_collapses_near_the_exact_stability_number() {
         assert!((ns - 3.78).abs() <= 0.05 * 3.78, "Ns {ns}");
     }
 }
+
+/// An L-shaped plate (a re-entrant corner) with a quadrilateral hole, h = 0.1, supported `on`
+/// its named base edge.
+const PLATE: &str = r#"
+name = "plate-with-hole"
+[body]
+zones = [
+  { name = "plate", polygon = [[0.0, 0.0], [4.0, 0.0], [4.0, 1.0], [2.5, 1.0], [2.5, 3.0], [0.0, 3.0]], edges = ["base", "", "", "", "", "left"], holes = [[[1.0, 1.0], [1.6, 1.2], [1.4, 1.8], [0.8, 1.6]]] },
+]
+[mesh]
+h = 0.1
+[material]
+model = "linear-elastic"
+young = 1.0e7
+poisson = 0.3
+density = 1000.0
+[gravity]
+g = [0.0, -9.81]
+[[fixed]]
+name = "base"
+on = "base"
+dofs = ["x", "y"]
+[steps]
+count = 1
+[history]
+columns = [{ name = "area", measure = "area" }, { name = "base_fy", measure = "reaction.base.fy" }]
+"#;
+
+/// Reference positions and triangles of the first field frame.
+fn frame(dir: &Path) -> (Vec<[f64; 2]>, Vec<[usize; 3]>) {
+    let script = "import h5py, os, sys\nd = sys.argv[1]\n\
+        f = h5py.File(os.path.join(d, sorted(os.listdir(d))[0]), 'r')\n\
+        x = f['geometry'][...] - f['point_data/displacement'][:, :2]\n\
+        print(len(x))\n\
+        for p in x: print(p[0], p[1])\n\
+        for t in f['connectivity'][...]: print(t[0], t[1], t[2])";
+    let out = std::process::Command::new("python3")
+        .args(["-c", script, &dir.join("fields").display().to_string()])
+        .output()
+        .expect("python3");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut lines = text.lines();
+    let n: usize = lines.next().unwrap().parse().unwrap();
+    let mut x = Vec::new();
+    let mut t = Vec::new();
+    for (k, l) in lines.enumerate() {
+        let v: Vec<&str> = l.split_whitespace().collect();
+        if k < n {
+            x.push([v[0].parse().unwrap(), v[1].parse().unwrap()]);
+        } else {
+            t.push([v[0].parse().unwrap(), v[1].parse().unwrap(), v[2].parse().unwrap()]);
+        }
+    }
+    (x, t)
+}
+
+#[test]
+fn a_polygon_with_a_hole_is_meshed_to_its_shape() {
+    use pfem_mpi::geometry::{Polygon, Shape};
+    let dir = workdir("plate-hole");
+    std::fs::write(dir.join("plate.toml"), PLATE.replace("name = \"plate-with-hole\"", "name = \"plate-with-hole\"\n[output]\nfields_every = 1")).unwrap();
+    ok(&dir, 1, &["new", "plate.toml", "-o", "p.h5"]);
+    ok(&dir, 2, &["p.h5", "--out", "run"]);
+    let hole = vec![[1.0, 1.0], [1.6, 1.2], [1.4, 1.8], [0.8, 1.6]];
+    let outer = vec![[0.0, 0.0], [4.0, 0.0], [4.0, 1.0], [2.5, 1.0], [2.5, 3.0], [0.0, 3.0]];
+    let plate = Shape::Polygon(Polygon::new(outer, vec![hole.clone()]).unwrap());
+    let hole = Shape::Polygon(Polygon::new(hole, vec![]).unwrap());
+    let (x, tris) = frame(&dir.join("run"));
+    let (mut area, mut deep_in_hole) = (0.0, 0);
+    let mut edges = std::collections::HashMap::new();
+    for t in &tris {
+        let [a, b, c] = t.map(|k| x[k]);
+        area += 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+        let m = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0];
+        deep_in_hole += usize::from(hole.signed_distance(m) < -0.05);
+        for (p, q) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            *edges.entry((p.min(q), p.max(q))).or_insert(0) += 1;
+        }
+    }
+    let exact = 9.0 - 0.4;
+    println!("mesh area {area} against {exact}: {:.3e}", area / exact - 1.0);
+    assert!((area / exact - 1.0).abs() < 5e-3, "area {area}");
+    assert_eq!(deep_in_hole, 0, "the hole must stay open");
+    let mut boundary = 0;
+    for ((p, q), n) in edges {
+        if n == 1 {
+            boundary += 1;
+            for k in [p, q] {
+                let d = plate.signed_distance(x[k]).abs();
+                assert!(d < 1e-9, "boundary vertex {:?} is {d} off the polygon", x[k]);
+            }
+        }
+    }
+    assert!(boundary > 100);
+    // The base carries the weight of the meshed plate, selected `on` its named edge.
+    let (_, rows) = history(&dir.join("run/history.csv"));
+    let (mesh_area, fy) = (rows[0][1], rows[0][2]);
+    let weight = 1000.0 * 9.81 * mesh_area;
+    assert!((fy - weight).abs() < 1e-9 * weight, "base reaction {fy}, weight {weight}");
+}
+
+/// Bad zones and boundaries: one clear error naming the file and the field, nothing written.
+#[test]
+fn bad_zones_are_refused_with_the_field_named() {
+    let dir = workdir("bad-zones");
+    let cases: &[(&str, &str, &[&str])] = &[
+        (
+            "[[0.0, 0.0], [4.0, 0.0], [4.0, 1.0], [2.5, 1.0], [2.5, 3.0], [0.0, 3.0]]",
+            "[[0.0, 0.0], [4.0, 0.0], [0.0, 3.0], [4.0, 3.0], [2.5, 3.0], [0.0, 1.0]]",
+            &["body.zones[0].polygon"],
+        ),
+        (
+            "holes = [[[1.0, 1.0], [1.6, 1.2], [1.4, 1.8], [0.8, 1.6]]]",
+            "holes = [[[5.0, 1.0], [5.6, 1.2], [5.4, 1.8], [4.8, 1.6]]]",
+            &["body.zones[0].polygon", "hole"],
+        ),
+        (
+            "on = \"base\"",
+            "on = \"seabed\"",
+            &["fixed[0].on", "seabed", "base", "left"],
+        ),
+        (
+            "edges = [\"base\", \"\", \"\", \"\", \"\", \"left\"],",
+            "edges = [\"base\"],",
+            &["body.zones[0].edges", "6"],
+        ),
+        (
+            "{ name = \"plate\",",
+            "{ name = \"other\", rectangle = { origin = [3.0, 0.0], size = [2.0, 2.0] } },\n  { name = \"plate\",",
+            &["body.zones[1]", "overlaps", "body.zones[0] (\"other\")"],
+        ),
+    ];
+    for (k, (from, to, needles)) in cases.iter().enumerate() {
+        let text = PLATE.replace(from, to);
+        assert_ne!(text, PLATE, "case {k}: the edit must apply");
+        let file = format!("bad{k}.toml");
+        std::fs::write(dir.join(&file), text).unwrap();
+        let out = run(&dir, 1, &["new", &file, "-o", "b.h5"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "case {k} was accepted");
+        assert!(err.contains(&file), "case {k}: {err}");
+        for n in *needles {
+            assert!(err.contains(n), "case {k}: {n:?} not in {err}");
+        }
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!dir.join("b.h5").exists());
+    }
+}

@@ -42,6 +42,9 @@ pub(super) fn check_until_step(opts: &RunOptions, sim: &Simulation) -> Result<()
 
 /// Area of the union of the scene's body rectangles (overlaps counted once).
 fn body_area(scene: &Scene) -> f64 {
+    if !scene.body.zones.is_empty() {
+        return crate::scene::zones::area(scene);
+    }
     let rects = &scene.body.rectangles;
     let mut xs: Vec<f64> = rects
         .iter()

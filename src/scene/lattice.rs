@@ -81,6 +81,9 @@ pub fn particle_count(scene: &Scene) -> u64 {
 pub fn generate_particles(scene: &Scene) -> ParticleSet {
     let h = scene.mesh.h;
     let width = crate::model::state_layout(scene).len();
+    if !scene.body.zones.is_empty() {
+        return finish(scene, super::zones::fill(scene, width));
+    }
     let Some(first) = scene.body.rectangles.first() else {
         return ParticleSet::with_capacity(0, width);
     };
@@ -99,8 +102,26 @@ pub fn generate_particles(scene: &Scene) -> ParticleSet {
     if !scene.mesh.fine.is_empty() {
         set = refine_regions(scene, set);
     }
+    finish(scene, set)
+}
+
+/// The jitter and the rigid bodies' carving, common to every body.
+fn finish(scene: &Scene, mut set: ParticleSet) -> ParticleSet {
+    let shapes = if scene.body.zones.is_empty() || scene.body.jitter == 0.0 {
+        Vec::new()
+    } else {
+        super::zones::shapes(scene).unwrap_or_default()
+    };
     for i in 0..set.len() {
-        set.position[i] = jittered(scene, set.gid[i], set.position[i], set.h[i]);
+        let (p, h) = (set.position[i], set.h[i]);
+        let deep = if scene.body.zones.is_empty() {
+            in_rectangles(scene, p, h)
+        } else {
+            super::zones::deep_inside(&shapes, p, 0.5 * h)
+        };
+        if deep {
+            set.position[i] = jittered(scene, set.gid[i], p, h);
+        }
     }
     if !scene.rigid.is_empty() {
         set = carve_rigid(scene, set);
@@ -223,14 +244,17 @@ fn refine_regions(scene: &Scene, base: ParticleSet) -> ParticleSet {
     set
 }
 
-/// `p` (spacing `h`) moved by the scene's `body.jitter` when it lies more than h/2 inside a
-/// rectangle.
+/// Whether `p` (spacing `h`) lies more than h/2 inside a body rectangle.
+fn in_rectangles(scene: &Scene, p: [f64; 2], h: f64) -> bool {
+    scene.body.rectangles.iter().any(|r| {
+        (0..2).all(|c| p[c] > r.origin[c] + 0.5 * h && p[c] < r.origin[c] + r.size[c] - 0.5 * h)
+    })
+}
+
+/// `p` (spacing `h`) moved by the scene's `body.jitter`, deterministically per particle id.
 fn jittered(scene: &Scene, gid: u64, p: [f64; 2], h: f64) -> [f64; 2] {
     let j = scene.body.jitter;
-    let inside = scene.body.rectangles.iter().any(|r| {
-        (0..2).all(|c| p[c] > r.origin[c] + 0.5 * h && p[c] < r.origin[c] + r.size[c] - 0.5 * h)
-    });
-    if j == 0.0 || !inside {
+    if j == 0.0 {
         return p;
     }
     let a = crate::rng::splitmix64(gid.wrapping_mul(2));

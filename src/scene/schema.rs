@@ -57,8 +57,8 @@ fn is_default_contact(c: &Contact) -> bool {
     *c == Contact::default()
 }
 
-/// `[body]`: the initial domain, a union of axis-aligned rectangles filled with a square
-/// particle lattice of spacing `mesh.h`.
+/// `[body]`: the initial domain: a union of axis-aligned rectangles filled with a square
+/// particle lattice of spacing `mesh.h`, or zones of any shape (`[[body.zones]]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Body {
@@ -66,7 +66,15 @@ pub struct Body {
     /// offset (from the first rectangle's origin) and every size must be a whole number of
     /// particle spacings, so that rectangle edges carry particles and adjacent rectangles share
     /// them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub rectangles: Vec<Rectangle>,
+    /// `[[body.zones]]`: the body as zones of any shape, instead of `rectangles`. Zones may
+    /// touch (sharing edges or vertices) but not overlap. Each is filled with particles: on
+    /// every boundary edge at spacing about `mesh.h` (vertices included), and a square lattice
+    /// of spacing `mesh.h` (anchored at the first zone's first vertex, so touching zones share
+    /// it) inside, lattice points closer than h/2 to a boundary dropped.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub zones: Vec<Zone>,
     /// Random offset of every particle lying more than h/2 inside a rectangle, as a fraction of
     /// its spacing h (the finer one inside `[[mesh.fine]]` regions) in each direction (0 <=
     /// jitter < 0.5; default 0). Deterministic per particle id. An irregular cloud has no grid
@@ -74,6 +82,38 @@ pub struct Body {
     /// approached slowly); supports and loads stay on the lattice.
     #[serde(default)]
     pub jitter: f64,
+}
+
+/// One zone of the body: exactly one of `polygon`, `circle` or `rectangle`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Zone {
+    /// Shown in messages; optional.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Vertices `[[x, y], ...]` (m) of a simple polygon, either orientation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polygon: Option<Vec<[f64; 2]>>,
+    /// Holes of the polygon, each a list of vertices inside it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub holes: Vec<Vec<[f64; 2]>>,
+    /// Names of the polygon's edges, edge k from vertex k to k + 1 (the last one closing the
+    /// ring): `edges = ["seabed", "", "", ""]`, "" for an unnamed edge. A selection's `on =
+    /// "seabed"` picks the particles on the edges of that name. Optional.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub edges: Vec<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub circle: Option<CircleZone>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rectangle: Option<Rectangle>,
+}
+
+/// `circle = { centre = [x, y], radius = r }` (m).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CircleZone {
+    pub centre: [f64; 2],
+    pub radius: f64,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -296,9 +336,14 @@ pub struct Fixed {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     /// `where = "x <= 0"`: comparisons `x <= c`, `x >= c`, `y <= c`, `y >= c` joined by `and`;
-    /// boundaries are matched within 1e-9 times the body's largest dimension.
-    #[serde(rename = "where")]
+    /// boundaries are matched within 1e-9 times the body's largest dimension. Optional with
+    /// `on` (then every particle of that boundary); at least one of the two.
+    #[serde(rename = "where", default = "Selector::all", skip_serializing_if = "Selector::is_all")]
     pub region: Selector,
+    /// `on = "seabed"`: the particles on the zone edges of that name (`body.zones[].edges`),
+    /// within 1e-6 mesh.h, and within `where` if given too.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub on: Option<String>,
     /// Constrained components, a non-empty subset of `["x", "y"]`.
     pub dofs: Vec<Dof>,
 }
@@ -322,8 +367,11 @@ pub struct Prescribed {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     /// Same syntax as `fixed.where`, e.g. `"y >= 10 and x <= 1"`.
-    #[serde(rename = "where")]
+    #[serde(rename = "where", default = "Selector::all", skip_serializing_if = "Selector::is_all")]
     pub region: Selector,
+    /// As `fixed.on` (with `select = "initial"` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub on: Option<String>,
     /// Prescribed components, a non-empty subset of `["x", "y"]`.
     pub dofs: Vec<Dof>,
     /// Displacement (m) reached at the end of loading, applied linearly over the steps. Only the

@@ -77,6 +77,17 @@ impl Selector {
         Ok(Selector { conditions })
     }
 
+    /// Every point (a `where` left out).
+    pub fn all() -> Self {
+        Selector {
+            conditions: Vec::new(),
+        }
+    }
+
+    pub fn is_all(&self) -> bool {
+        self.conditions.is_empty()
+    }
+
     pub fn conditions(&self) -> &[Condition] {
         &self.conditions
     }

@@ -124,7 +124,8 @@ fn check_adapt(s: &Scene, a: &super::schema::Adapt) -> Result<(), Invalid> {
         .rectangles
         .iter()
         .map(|r| r.size[0] * r.size[1])
-        .sum();
+        .sum::<f64>()
+        + super::zones::area(s);
     let upper = area / (a.h_min * a.h_min);
     if upper > MAX_PARTICLES as f64 {
         return fail(
@@ -147,8 +148,32 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
     }
 
     let rects = root.join("body").join("rectangles");
-    if s.body.rectangles.is_empty() {
-        return fail(rects, "must contain at least one rectangle".to_string());
+    match (s.body.rectangles.is_empty(), s.body.zones.is_empty()) {
+        (true, true) => {
+            return fail(
+                rects,
+                "must contain at least one rectangle (or give the body as [[body.zones]])"
+                    .to_string(),
+            )
+        }
+        (false, false) => {
+            return fail(
+                root.join("body").join("zones"),
+                "a body is either `rectangles` or `zones`, not both".to_string(),
+            )
+        }
+        (true, false) => {
+            super::zones::shapes(s)?;
+            if !s.mesh.fine.is_empty() {
+                return fail(
+                    root.join("mesh").join("fine"),
+                    "is not available with [[body.zones]] yet: give the body as rectangles, \
+                     or a finer mesh.h"
+                        .to_string(),
+                );
+            }
+        }
+        (false, true) => {}
     }
     for (i, r) in s.body.rectangles.iter().enumerate() {
         finite2(rects.at(i).join("origin"), r.origin)?;
@@ -359,9 +384,24 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
     Ok(())
 }
 
-/// Rectangle corners must sit on the lattice so that edges carry particles.
+/// Rectangle corners must sit on the lattice so that edges carry particles; zones hold no more
+/// particles than the limit.
 fn check_alignment(s: &Scene) -> Result<(), Invalid> {
     let h = s.mesh.h;
+    if s.body.rectangles.is_empty() {
+        let [lo, hi] = s.bounding_box();
+        let upper = ((hi[0] - lo[0]) / h + 2.0) * ((hi[1] - lo[1]) / h + 2.0);
+        if upper > MAX_PARTICLES as f64 {
+            return fail(
+                FieldPath::key("mesh").join("h"),
+                format!(
+                    "h = {h} would create about {upper:.3e} particles, more than the limit of \
+                     {MAX_PARTICLES} ({LIMIT_REASON})"
+                ),
+            );
+        }
+        return Ok(());
+    }
     let anchor = s.body.rectangles[0].origin;
     let rects = FieldPath::key("body").join("rectangles");
     for (i, r) in s.body.rectangles.iter().enumerate() {
@@ -409,20 +449,52 @@ fn check_alignment(s: &Scene) -> Result<(), Invalid> {
     Ok(())
 }
 
+/// A selection (`where` within `on`) that picks at least one particle; `on` naming a boundary
+/// that exists. `entry` is the table's path.
 fn check_selects_something(
-    path: FieldPath,
-    region: &Selector,
+    entry: FieldPath,
+    (region, on): (&Selector, Option<&str>),
+    boundaries: &crate::geometry::NamedBoundaries,
+    s: &Scene,
     positions: &[[f64; 2]],
-    tol: f64,
 ) -> Result<(), Invalid> {
-    if positions.iter().any(|&p| region.matches(p, tol)) {
-        Ok(())
-    } else {
-        fail(
-            path,
-            format!("\"{region}\" selects no particle of the body"),
-        )
+    let tol = s.tolerance();
+    if region.is_all() && on.is_none() {
+        return fail(
+            entry.join("where"),
+            "is required (or `on`, naming a boundary): which particles?".to_string(),
+        );
     }
+    if let Some(name) = on {
+        if let Err(e) = boundaries.distance(name, [0.0; 2]) {
+            let known = if e.known.is_empty() {
+                "the body has no named boundary (name polygon edges with body.zones[].edges)"
+                    .to_string()
+            } else {
+                format!("the named boundaries are {}", e.known.join(", "))
+            };
+            return fail(
+                entry.join("on"),
+                format!("\"{name}\" names no boundary: {known}"),
+            );
+        }
+    }
+    let on_it = |p: [f64; 2]| {
+        on.is_none_or(|n| crate::model::on_boundary(boundaries, n, p, s.mesh.h))
+    };
+    if positions.iter().any(|&p| region.matches(p, tol) && on_it(p)) {
+        return Ok(());
+    }
+    let what = match (region.is_all(), on) {
+        (_, None) => format!("\"{region}\""),
+        (true, Some(n)) => format!("on = \"{n}\""),
+        (false, Some(n)) => format!("\"{region}\" on \"{n}\""),
+    };
+    let key = if region.is_all() { "on" } else { "where" };
+    fail(
+        entry.join(key),
+        format!("{what} selects no particle of the body"),
+    )
 }
 
 /// Checks that depend on the generated lattice: selections must select something and point
@@ -430,13 +502,23 @@ fn check_selects_something(
 fn check_against_particles(s: &Scene) -> Result<(), Invalid> {
     let particles = generate_particles(s);
     let tol = s.tolerance();
+    let boundaries = crate::model::named_boundaries(s);
+    let x = &particles.position;
     for (i, f) in s.fixed.iter().enumerate() {
-        let path = FieldPath::key("fixed").at(i).join("where");
-        check_selects_something(path, &f.region, &particles.position, tol)?;
+        let entry = FieldPath::key("fixed").at(i);
+        check_selects_something(entry, (&f.region, f.on.as_deref()), &boundaries, s, x)?;
     }
     for (i, p) in s.prescribed.iter().enumerate() {
-        let path = FieldPath::key("prescribed").at(i).join("where");
-        check_selects_something(path, &p.region, &particles.position, tol)?;
+        let entry = FieldPath::key("prescribed").at(i);
+        if p.on.is_some() && p.select == Selection::Current {
+            return fail(
+                entry.join("on"),
+                "selects by the body's initial boundary, so it needs select = \"initial\"; a \
+                 platen (select = \"current\") selects with `where`"
+                    .to_string(),
+            );
+        }
+        check_selects_something(entry, (&p.region, p.on.as_deref()), &boundaries, s, x)?;
     }
     for (i, p) in s.point_load.iter().enumerate() {
         if let Some((_, dist)) = lattice::nearest(&particles, p.at) {

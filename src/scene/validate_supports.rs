@@ -12,19 +12,33 @@ fn fail<T>(path: FieldPath, message: String) -> Result<T, Invalid> {
     Err((path, message))
 }
 
+/// How selections match: the slack of `where`, and the named boundaries of `on`.
+struct Sel {
+    tol: f64,
+    h: f64,
+    boundaries: crate::geometry::NamedBoundaries,
+}
+
+impl Sel {
+    fn on(&self, name: Option<&str>, x: [f64; 2]) -> bool {
+        name.is_none_or(|n| crate::model::on_boundary(&self.boundaries, n, x, self.h))
+    }
+}
+
 /// The `[[fixed]]` entry (index < fixed.len()) or `[[prescribed]]` entry constraining each
 /// component of the particle at `x`, first entry first.
-fn constrained_by(s: &Scene, x: [f64; 2], tol: f64) -> [Vec<FieldPath>; 2] {
+fn constrained_by(s: &Scene, x: [f64; 2], sel: &Sel) -> [Vec<FieldPath>; 2] {
+    let tol = sel.tol;
     let mut by: [Vec<FieldPath>; 2] = Default::default();
     for (i, f) in s.fixed.iter().enumerate() {
-        if f.region.matches(x, tol) {
+        if f.region.matches(x, tol) && sel.on(f.on.as_deref(), x) {
             for d in &f.dofs {
                 by[d.index()].push(FieldPath::key("fixed").at(i));
             }
         }
     }
     for (i, p) in s.prescribed.iter().enumerate() {
-        if p.region.matches(x, tol) {
+        if p.region.matches(x, tol) && sel.on(p.on.as_deref(), x) {
             for d in &p.dofs {
                 by[d.index()].push(FieldPath::key("prescribed").at(i));
             }
@@ -52,9 +66,9 @@ fn entry_text(s: &Scene, path: &FieldPath) -> String {
 
 /// A component held by a `[[fixed]]` and a `[[prescribed]]` entry at once: the prescribed
 /// motion would silently win over the clamp.
-fn check_overlaps(s: &Scene, positions: &[[f64; 2]], tol: f64) -> Result<(), Invalid> {
+fn check_overlaps(s: &Scene, positions: &[[f64; 2]], sel: &Sel) -> Result<(), Invalid> {
     for &x in positions {
-        for (d, by) in constrained_by(s, x, tol).iter().enumerate() {
+        for (d, by) in constrained_by(s, x, sel).iter().enumerate() {
             let fixed = by.iter().find(|p| p.to_string().starts_with("fixed"));
             let prescribed = by.iter().find(|p| p.to_string().starts_with("prescribed"));
             if let (Some(f), Some(p)) = (fixed, prescribed) {
@@ -80,13 +94,13 @@ fn check_overlaps(s: &Scene, positions: &[[f64; 2]], tol: f64) -> Result<(), Inv
 fn check_point_loads(
     s: &Scene,
     positions: &[[f64; 2]],
-    tol: f64,
+    sel: &Sel,
     nearest: impl Fn([f64; 2]) -> Option<usize>,
 ) -> Result<(), Invalid> {
     for (i, load) in s.point_load.iter().enumerate() {
         let Some(p) = nearest(load.at) else { continue };
         let x = positions[p];
-        let by = constrained_by(s, x, tol);
+        let by = constrained_by(s, x, sel);
         let loaded: Vec<usize> = (0..2).filter(|&d| load.force[d] != 0.0).collect();
         if !loaded.is_empty() && loaded.iter().all(|&d| !by[d].is_empty()) {
             let holders: Vec<String> = loaded
@@ -145,13 +159,22 @@ fn rectangle_groups(s: &Scene) -> Vec<usize> {
 /// two abscissae, plus one constraint of the other component. Rigid bodies in contact do not
 /// count: contact is found during the step, after the first Newton iteration needs a
 /// non-singular matrix.
-fn check_rigid_modes(s: &Scene, positions: &[[f64; 2]], tol: f64) -> Result<(), Invalid> {
-    let groups = rectangle_groups(s);
+fn check_rigid_modes(s: &Scene, positions: &[[f64; 2]], sel: &Sel) -> Result<(), Invalid> {
+    let tol = sel.tol;
+    // A body of zones is held as one part.
+    let zoned = s.body.rectangles.is_empty();
+    let groups = if zoned {
+        vec![0]
+    } else {
+        rectangle_groups(s)
+    };
     let rects = &s.body.rectangles;
     let inside = |x: [f64; 2], r: usize| {
-        (0..2).all(|c| {
-            x[c] >= rects[r].origin[c] - tol && x[c] <= rects[r].origin[c] + rects[r].size[c] + tol
-        })
+        zoned
+            || (0..2).all(|c| {
+                x[c] >= rects[r].origin[c] - tol
+                    && x[c] <= rects[r].origin[c] + rects[r].size[c] + tol
+            })
     };
     let n_groups = groups.iter().max().map_or(0, |g| g + 1);
     // Per group: the heights of x-constrained particles and the abscissae of y-constrained ones
@@ -159,11 +182,11 @@ fn check_rigid_modes(s: &Scene, positions: &[[f64; 2]], tol: f64) -> Result<(), 
     let mut x_heights = vec![(f64::INFINITY, f64::NEG_INFINITY); n_groups];
     let mut y_abscissae = vec![(f64::INFINITY, f64::NEG_INFINITY); n_groups];
     for &x in positions {
-        let Some(r) = (0..rects.len()).find(|&r| inside(x, r)) else {
+        let Some(r) = (0..groups.len()).find(|&r| inside(x, r)) else {
             continue;
         };
         let g = groups[r];
-        let by = constrained_by(s, x, tol);
+        let by = constrained_by(s, x, sel);
         if !by[0].is_empty() {
             x_heights[g] = (x_heights[g].0.min(x[1]), x_heights[g].1.max(x[1]));
         }
@@ -204,8 +227,13 @@ fn check_rigid_modes(s: &Scene, positions: &[[f64; 2]], tol: f64) -> Result<(), 
                     members.join(", ")
                 )
             };
+            let at = if zoned {
+                FieldPath::key("body").join("zones")
+            } else {
+                FieldPath::key("body").join("rectangles").at(first)
+            };
             return fail(
-                FieldPath::key("body").join("rectangles").at(first),
+                at,
                 format!(
                     "{part} is not held against rigid-body motion: {why}; its stiffness \
                      matrix would be singular. Add [[fixed]] or [[prescribed]] supports to it"
@@ -223,7 +251,12 @@ pub(super) fn check(
     tol: f64,
     nearest: impl Fn([f64; 2]) -> Option<usize>,
 ) -> Result<(), Invalid> {
-    check_overlaps(s, positions, tol)?;
-    check_point_loads(s, positions, tol, nearest)?;
-    check_rigid_modes(s, positions, tol)
+    let sel = Sel {
+        tol,
+        h: s.mesh.h,
+        boundaries: crate::model::named_boundaries(s),
+    };
+    check_overlaps(s, positions, &sel)?;
+    check_point_loads(s, positions, &sel, nearest)?;
+    check_rigid_modes(s, positions, &sel)
 }

@@ -1,0 +1,164 @@
+//! `[[body.zones]]`: the scene's zone tables as [`crate::geometry`] shapes, their checks, and the
+//! particle cloud that fills them.
+
+use super::field_path::FieldPath;
+use super::schema::{Scene, Zone};
+use crate::case_file::ParticleSet;
+use crate::geometry::{self, FillParams, Shape};
+
+/// The shape of zone `z`, checked (simple polygon, holes inside, positive radius and sizes), or
+/// the field at fault with a message.
+pub fn shape(z: &Zone, at: &FieldPath) -> Result<Shape, (FieldPath, String)> {
+    let given = [z.polygon.is_some(), z.circle.is_some(), z.rectangle.is_some()];
+    if given.iter().filter(|g| **g).count() != 1 {
+        return Err((
+            at.clone(),
+            "needs exactly one of `polygon`, `circle` or `rectangle`".to_string(),
+        ));
+    }
+    let finite = |p: &[f64; 2]| p.iter().all(|x| x.is_finite());
+    if z.polygon.is_none() {
+        let key = match (z.holes.is_empty(), z.edges.is_empty()) {
+            (false, _) => Some("holes"),
+            (_, false) => Some("edges"),
+            _ => None,
+        };
+        if let Some(key) = key {
+            return Err((at.join(key), "belongs to a `polygon` zone".to_string()));
+        }
+    }
+    if let Some(c) = &z.circle {
+        if !finite(&c.centre) {
+            return Err((at.join("circle").join("centre"), "must be finite".to_string()));
+        }
+        return geometry::Circle::new(c.centre, c.radius)
+            .map(Shape::Circle)
+            .map_err(|e| (at.join("circle"), e.to_string()));
+    }
+    if let Some(r) = &z.rectangle {
+        if !finite(&r.origin) || !finite(&r.size) {
+            return Err((at.join("rectangle"), "must be finite".to_string()));
+        }
+        return geometry::Rectangle::new(r.origin, r.size)
+            .map(Shape::Rectangle)
+            .map_err(|e| (at.join("rectangle"), e.to_string()));
+    }
+    let outer = z.polygon.clone().unwrap_or_default();
+    if let Some(k) = outer.iter().position(|p| !finite(p)) {
+        return Err((at.join("polygon"), format!("vertex {k} is not finite")));
+    }
+    for (h, hole) in z.holes.iter().enumerate() {
+        if let Some(k) = hole.iter().position(|p| !finite(p)) {
+            return Err((at.join("holes").at(h), format!("vertex {k} is not finite")));
+        }
+    }
+    let names = if z.edges.is_empty() {
+        Vec::new()
+    } else {
+        if z.edges.len() != outer.len() {
+            return Err((
+                at.join("edges"),
+                format!(
+                    "names {} edges but the polygon has {} (edge k runs from vertex k to k + 1)",
+                    z.edges.len(),
+                    outer.len()
+                ),
+            ));
+        }
+        let named = |n: &String| (!n.trim().is_empty()).then(|| n.clone());
+        vec![z.edges.iter().map(named).collect()]
+    };
+    geometry::Polygon::with_edge_names(outer, z.holes.clone(), names)
+        .map(Shape::Polygon)
+        .map_err(|e| (at.join("polygon"), e.to_string()))
+}
+
+/// Every zone's shape, checked one by one and then pairwise for overlaps.
+pub fn shapes(scene: &Scene) -> Result<Vec<Shape>, (FieldPath, String)> {
+    let at = FieldPath::key("body").join("zones");
+    let shapes = scene
+        .body
+        .zones
+        .iter()
+        .enumerate()
+        .map(|(i, z)| shape(z, &at.at(i)))
+        .collect::<Result<Vec<_>, _>>()?;
+    geometry::validate_zones(&shapes).map_err(|e| {
+        let [a, b] = e.zones;
+        let label = |i: usize| match &scene.body.zones[i].name {
+            Some(n) => format!("body.zones[{i}] (\"{n}\")"),
+            None => format!("body.zones[{i}]"),
+        };
+        (
+            at.at(b),
+            format!("overlaps {}: zones may touch but not overlap", label(a)),
+        )
+    })?;
+    Ok(shapes)
+}
+
+/// `[[xmin, ymin], [xmax, ymax]]` of the zones as written (no checks).
+pub fn bounding_box(zones: &[Zone]) -> [[f64; 2]; 2] {
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    let mut take = |p: [f64; 2]| {
+        for c in 0..2 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    };
+    for z in zones {
+        z.polygon.iter().flatten().for_each(|p| take(*p));
+        if let Some(c) = &z.circle {
+            take([c.centre[0] - c.radius, c.centre[1] - c.radius]);
+            take([c.centre[0] + c.radius, c.centre[1] + c.radius]);
+        }
+        if let Some(r) = &z.rectangle {
+            take(r.origin);
+            take([r.origin[0] + r.size[0], r.origin[1] + r.size[1]]);
+        }
+    }
+    [lo, hi]
+}
+
+/// Where every zone's lattice is anchored: the first zone's first vertex (its centre for a
+/// circle), so that a rectangle zone on the lattice fills as `body.rectangles` does.
+fn anchor(zones: &[Zone]) -> [f64; 2] {
+    let z = &zones[0];
+    z.polygon
+        .as_ref()
+        .and_then(|p| p.first().copied())
+        .or(z.rectangle.map(|r| r.origin))
+        .or(z.circle.map(|c| c.centre))
+        .unwrap_or([0.0; 2])
+}
+
+/// The particles of a zone body (`width`: scalars of a state row), sorted by y then x, ids
+/// `0..n`, each with the spacing `mesh.h`. A scene that fails its checks gives none (the
+/// checks report it).
+pub fn fill(scene: &Scene, width: usize) -> ParticleSet {
+    let mut set = ParticleSet::with_capacity(0, width);
+    let Ok(shapes) = shapes(scene) else {
+        return set;
+    };
+    let params = FillParams::new(scene.mesh.h, anchor(&scene.body.zones));
+    let Ok(points) = geometry::fill_zones(&shapes, &params) else {
+        return set;
+    };
+    for (gid, p) in points.iter().enumerate() {
+        set.push_new(gid as u64, p.position, p.h);
+    }
+    set
+}
+
+/// Total area of the zones (they do not overlap).
+pub fn area(scene: &Scene) -> f64 {
+    shapes(scene)
+        .map(|s| s.iter().map(Shape::area).sum())
+        .unwrap_or(0.0)
+}
+
+/// Whether `p` lies more than `d` inside a zone (for the jitter).
+pub fn deep_inside(shapes: &[Shape], p: [f64; 2], d: f64) -> bool {
+    shapes.iter().any(|s| s.signed_distance(p) < -d)
+}
