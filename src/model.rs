@@ -1,10 +1,10 @@
 //! What a scene means for the solver: material, element, supports, prescribed motion, loads.
 
+use crate::geometry::NamedBoundaries;
 use crate::material::elastic::LinearElastic;
 use crate::material::tresca::{CuProfile, Tresca};
 use crate::material::{Material, StateLayout};
 use crate::rigid::RigidBody;
-use crate::geometry::NamedBoundaries;
 use crate::scene::{Axis, ElementChoice, Fixed, MaterialModel, Prescribed, Scene, Selection};
 use crate::solve::Kernel;
 
@@ -205,9 +205,7 @@ impl Model {
 
     fn selects(&self, p: &Prescribed, x0: [f64; 2], x: [f64; 2], lambda: f64) -> bool {
         match p.select {
-            Selection::Initial => {
-                p.region.matches(x0, self.tol) && self.on(p.on.as_deref(), x0)
-            }
+            Selection::Initial => p.region.matches(x0, self.tol) && self.on(p.on.as_deref(), x0),
             Selection::Current => {
                 let mut back = x;
                 for d in &p.dofs {

@@ -72,9 +72,9 @@ mod validate_fine;
 pub mod validate_rigid;
 #[path = "scene/validate_supports.rs"]
 mod validate_supports;
-pub mod zones;
 #[path = "scene/value_de.rs"]
 mod value_de;
+pub mod zones;
 
 use std::borrow::Cow;
 use std::path::Path;

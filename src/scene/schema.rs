@@ -338,7 +338,11 @@ pub struct Fixed {
     /// `where = "x <= 0"`: comparisons `x <= c`, `x >= c`, `y <= c`, `y >= c` joined by `and`;
     /// boundaries are matched within 1e-9 times the body's largest dimension. Optional with
     /// `on` (then every particle of that boundary); at least one of the two.
-    #[serde(rename = "where", default = "Selector::all", skip_serializing_if = "Selector::is_all")]
+    #[serde(
+        rename = "where",
+        default = "Selector::all",
+        skip_serializing_if = "Selector::is_all"
+    )]
     pub region: Selector,
     /// `on = "seabed"`: the particles on the zone edges of that name (`body.zones[].edges`),
     /// within 1e-6 mesh.h, and within `where` if given too.
@@ -367,7 +371,11 @@ pub struct Prescribed {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     /// Same syntax as `fixed.where`, e.g. `"y >= 10 and x <= 1"`.
-    #[serde(rename = "where", default = "Selector::all", skip_serializing_if = "Selector::is_all")]
+    #[serde(
+        rename = "where",
+        default = "Selector::all",
+        skip_serializing_if = "Selector::is_all"
+    )]
     pub region: Selector,
     /// As `fixed.on` (with `select = "initial"` only).
     #[serde(default, skip_serializing_if = "Option::is_none")]

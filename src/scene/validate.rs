@@ -479,10 +479,12 @@ fn check_selects_something(
             );
         }
     }
-    let on_it = |p: [f64; 2]| {
-        on.is_none_or(|n| crate::model::on_boundary(boundaries, n, p, s.mesh.h))
-    };
-    if positions.iter().any(|&p| region.matches(p, tol) && on_it(p)) {
+    let on_it =
+        |p: [f64; 2]| on.is_none_or(|n| crate::model::on_boundary(boundaries, n, p, s.mesh.h));
+    if positions
+        .iter()
+        .any(|&p| region.matches(p, tol) && on_it(p))
+    {
         return Ok(());
     }
     let what = match (region.is_all(), on) {

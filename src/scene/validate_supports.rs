@@ -163,11 +163,7 @@ fn check_rigid_modes(s: &Scene, positions: &[[f64; 2]], sel: &Sel) -> Result<(),
     let tol = sel.tol;
     // A body of zones is held as one part.
     let zoned = s.body.rectangles.is_empty();
-    let groups = if zoned {
-        vec![0]
-    } else {
-        rectangle_groups(s)
-    };
+    let groups = if zoned { vec![0] } else { rectangle_groups(s) };
     let rects = &s.body.rectangles;
     let inside = |x: [f64; 2], r: usize| {
         zoned

@@ -9,7 +9,11 @@ use crate::geometry::{self, FillParams, Shape};
 /// The shape of zone `z`, checked (simple polygon, holes inside, positive radius and sizes), or
 /// the field at fault with a message.
 pub fn shape(z: &Zone, at: &FieldPath) -> Result<Shape, (FieldPath, String)> {
-    let given = [z.polygon.is_some(), z.circle.is_some(), z.rectangle.is_some()];
+    let given = [
+        z.polygon.is_some(),
+        z.circle.is_some(),
+        z.rectangle.is_some(),
+    ];
     if given.iter().filter(|g| **g).count() != 1 {
         return Err((
             at.clone(),
@@ -29,7 +33,10 @@ pub fn shape(z: &Zone, at: &FieldPath) -> Result<Shape, (FieldPath, String)> {
     }
     if let Some(c) = &z.circle {
         if !finite(&c.centre) {
-            return Err((at.join("circle").join("centre"), "must be finite".to_string()));
+            return Err((
+                at.join("circle").join("centre"),
+                "must be finite".to_string(),
+            ));
         }
         return geometry::Circle::new(c.centre, c.radius)
             .map(Shape::Circle)
