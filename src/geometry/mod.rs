@@ -5,13 +5,15 @@
 //! - [`Polygon`] (simple, with holes, either orientation, optional edge names), [`Circle`],
 //!   [`Rectangle`], behind [`Shape`]: `locate`/`contains` (closed: boundary points are
 //!   contained; exact for polygons), `signed_distance` (negative inside), `area`, `bbox`,
-//!   `boundary` (named segments, interior on the left). Queries cost O(1) on average through a
-//!   uniform grid over the edges built once per polygon.
+//!   `boundary` (named segments, interior on the left). Containment costs O(1) through a grid
+//!   over the edges (crowded cells get finer grids), distance O(log n) through a bounding-volume
+//!   hierarchy, both built once per polygon.
 //! - [`ShapeError`] for a polygon that is not simple (with the ring and edges), and
 //!   [`validate_zones`]/[`overlap`] for zones whose interiors intersect (touching is allowed).
 //! - [`fill_zones`]: boundary particles at spacing about h on every edge, a global lattice
 //!   clipped to each zone, lattice points within [`DROP_FACTOR`] h of a boundary dropped; each
-//!   point once (shared boundaries go to the lowest zone index), sorted by y then x.
+//!   point once (shared boundaries go to the lowest zone index), sorted by y then x;
+//!   [`fill_zones_graded`] with finer spacing in [`FineRegion`]s of any shape.
 //! - [`read_msh`]: MSH 4.1 (ASCII or binary) nodes, elements and local mesh size per physical
 //!   surface, segments per physical curve; [`GmshError`] names the file.
 //! - [`NamedBoundaries`]: zone edge names and physical curves by name, to select points.
