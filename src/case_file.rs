@@ -135,9 +135,12 @@ pub fn new_case(scene: &Scene, source: &str) -> (CaseHeader, ParticleSet) {
         .filter_map(|at| lattice::nearest(&particles, at).map(|(gid, _)| gid))
         .collect();
     // A scene that fails here fails again, with its message, when the case is loaded.
-    if let Ok(material) = crate::model::material_of(scene) {
-        for (x, state) in particles.position.iter().zip(particles.state.iter_mut()) {
-            material.initial_internal(*x, &mut state[crate::material::STRESS_LEN..]);
+    if let Ok(materials) = crate::model::materials_of(scene) {
+        let points = particles.position.iter().zip(&particles.material);
+        for ((x, &m), state) in points.zip(particles.state.iter_mut()) {
+            if let Some(material) = materials.get(m as usize) {
+                material.initial_internal(*x, &mut state[crate::material::STRESS_LEN..]);
+            }
         }
     }
     if let Some(g) = &scene.geostatic {
@@ -281,6 +284,7 @@ fn read_contents(comm: &SimpleCommunicator, file: &File, path: &Path) -> Result<
         h: vec![0.0; count],
         state: crate::material::Rows::zeros(width, count),
         flags: vec![0; count],
+        material: vec![0; count],
     };
     let [gid, position, displacement, h, state, flags, increment] = datasets::columns(width);
     let read = (|| {
@@ -338,6 +342,18 @@ fn read_contents(comm: &SimpleCommunicator, file: &File, path: &Path) -> Result<
         ),
     ];
     // Every rank has the same outcomes (each checksum is a total over all ranks).
+    let material = datasets::material_column();
+    let sums = sums.into_iter().chain(
+        read_materials(
+            comm,
+            file,
+            path,
+            block.start as usize..block.end as usize,
+            n,
+            &mut p.material,
+        )?
+        .map(|o| (&material, o)),
+    );
     for (c, outcome) in sums {
         outcome.map_err(|m| {
             CaseError::new(path, CaseErrorKind::Malformed, m).at(format!(
@@ -351,6 +367,40 @@ fn read_contents(comm: &SimpleCommunicator, file: &File, path: &Path) -> Result<
 }
 
 /// The block this rank wrote, when the file was written by as many ranks as read it.
+/// Collective. The optional `/particles/material` rows `rows` of `n` into `out` (left zero
+/// without the dataset), and its checksum's outcome.
+fn read_materials(
+    comm: &SimpleCommunicator,
+    file: &File,
+    path: &Path,
+    rows: Range<usize>,
+    n: u64,
+    out: &mut [u32],
+) -> Result<Option<Result<(), String>>, CaseError> {
+    let Ok(ds) = file
+        .group(datasets::GROUP)
+        .and_then(|g| g.dataset("material"))
+    else {
+        return Ok(None);
+    };
+    let bad = |m: String| {
+        CaseError::new(path, CaseErrorKind::Malformed, m).at("dataset /particles/material")
+    };
+    let shape = ds.shape();
+    let dtype = ds.dtype().and_then(|t| t.to_descriptor());
+    let checked = if shape != [n as usize] {
+        Err(bad(format!("expected shape ({n}), found {shape:?}")))
+    } else if dtype.as_ref().ok() != Some(&u32::type_descriptor()) {
+        Err(bad("expected type u32".to_string()))
+    } else {
+        Ok(())
+    };
+    agree(comm, path, checked)?;
+    let read = read_column(&ds, 0, rows.clone(), out).map_err(|e| bad(format!("cannot read: {e}")));
+    agree(comm, path, read)?;
+    Ok(Some(checksum::verify(comm, &ds, rows.start, 0, out)))
+}
+
 /// The column names of a state dataset: its `names` attribute, or version 1's fixed nine.
 fn stored_columns(
     header: &CaseHeader,

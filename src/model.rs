@@ -2,29 +2,54 @@
 
 use crate::geometry::NamedBoundaries;
 use crate::material::elastic::LinearElastic;
+use crate::material::placed::{union_layout, Placed};
 use crate::material::tresca::{CuProfile, Tresca};
-use crate::material::{Material, StateLayout};
+use crate::material::{InternalVar, Material, MaterialError, StateLayout};
 use crate::rigid::RigidBody;
 use crate::scene::{Axis, ElementChoice, Fixed, MaterialModel, Prescribed, Scene, Selection};
 use crate::solve::Kernel;
+use crate::solve::Law;
 
-/// The layout of the state rows of a scene's material: what case files, checkpoints and output
-/// hold per particle and Gauss point. It depends on the model alone (not on its parameters), so
-/// it is known before the parameters are checked.
-pub fn state_layout(scene: &Scene) -> StateLayout {
-    match scene.material.model {
-        MaterialModel::LinearElastic => StateLayout::default(),
-        MaterialModel::Tresca if scene.material.cu_gradient != 0.0 => {
-            StateLayout::new(&crate::material::tresca::VARIABLES_WITH_CU)
+/// The internal variables of a scene material's model. They depend on the model alone (not on
+/// its parameters' values), so they are known before the parameters are checked.
+fn model_variables(m: &crate::scene::Material) -> &'static [InternalVar] {
+    match m.model {
+        MaterialModel::LinearElastic => &[],
+        MaterialModel::Tresca if m.cu_gradient != 0.0 => {
+            &crate::material::tresca::VARIABLES_WITH_CU
         }
-        MaterialModel::Tresca => StateLayout::new(&crate::material::tresca::VARIABLES),
+        MaterialModel::Tresca => &crate::material::tresca::VARIABLES,
     }
 }
 
-/// The constitutive model of a scene, its parameters checked.
-pub fn material_of(scene: &Scene) -> Result<Box<dyn Material>, String> {
-    let m = &scene.material;
-    let named = |e: crate::material::MaterialError| format!("material: {e}");
+/// The layout of the state rows of a scene: what case files, checkpoints and output hold per
+/// particle and Gauss point. With several materials, the union of their variables.
+pub fn state_layout(scene: &Scene) -> StateLayout {
+    union_layout(scene.material.all().iter().map(model_variables))
+}
+
+/// The constitutive models of a scene, in its `[[material]]` order, their parameters checked;
+/// with several materials each works in the scene's union layout.
+pub fn materials_of(scene: &Scene) -> Result<Vec<Box<dyn Material>>, String> {
+    let all = scene.material.all();
+    let layout = state_layout(scene);
+    let mut out = Vec::with_capacity(all.len());
+    for (i, m) in all.iter().enumerate() {
+        let model = material_of(m).map_err(|e| match all.len() {
+            1 => format!("material: {e}"),
+            _ => format!("material[{i}]: {e}"),
+        })?;
+        out.push(match all.len() {
+            1 => model,
+            _ => Box::new(Placed::new(model, &layout)) as Box<dyn Material>,
+        });
+    }
+    Ok(out)
+}
+
+/// The constitutive model of one scene material, its parameters checked.
+fn material_of(m: &crate::scene::Material) -> Result<Box<dyn Material>, MaterialError> {
+    let named = |e: MaterialError| e;
     Ok(match m.model {
         MaterialModel::LinearElastic => {
             Box::new(LinearElastic::new(m.young, m.poisson).map_err(named)?)
@@ -54,24 +79,30 @@ pub fn on_boundary(b: &NamedBoundaries, name: &str, x0: [f64; 2], h: f64) -> boo
 }
 
 pub struct Model {
-    pub material: Box<dyn Material>,
+    /// The scene's materials, in its `[[material]]` order (a particle's `material` indexes it).
+    pub materials: Vec<Box<dyn Material>>,
+    /// Bulk modulus of each material (the mixed kernel's pressure–volume relation).
+    pub bulk: Vec<f64>,
     pub kernel: Kernel,
-    pub body_force: [f64; 2],
+    /// Body force per unit volume of each material at load factor 1.
+    pub body_force: Vec<[f64; 2]>,
     /// Selector tolerance: 1e-9 of the body's size.
     pub tol: f64,
     /// The `[[rigid]]` bodies, in scene order.
     pub bodies: Vec<RigidBody>,
     /// The named zone edges that `on =` selections pick.
     pub boundaries: NamedBoundaries,
+    /// The zones as drawn, with each one's material (empty for a body of rectangles).
+    pub zones: Vec<(crate::geometry::Shape, u32)>,
     pub scene: Scene,
 }
 
 impl Model {
     pub fn new(scene: &Scene) -> Result<Model, String> {
         let m = &scene.material;
-        let material = material_of(scene)?;
+        let materials = materials_of(scene)?;
         // Incompressible plastic flow locks the displacement-only element.
-        let mixed_default = material.yields();
+        let mixed_default = materials.iter().any(|m| m.yields());
         let mixed = match scene.solver.element {
             ElementChoice::Auto => mixed_default,
             ElementChoice::P2 => false,
@@ -80,7 +111,6 @@ impl Model {
         let g = m.young / (2.0 * (1.0 + m.poisson));
         let kernel = if mixed {
             Kernel::P2P1 {
-                bulk: m.young / (3.0 * (1.0 - 2.0 * m.poisson)),
                 scale: g / scene.mesh.h,
             }
         } else {
@@ -98,41 +128,73 @@ impl Model {
                 .map_err(|(path, e)| format!("{path}: {e}"))?;
             bodies.push(RigidBody::new(r, shape, m.cu, scene.steps.count));
         }
+        let shapes = crate::scene::zones::shapes(scene).unwrap_or_default();
+        let zones = shapes
+            .into_iter()
+            .zip(&scene.body.zones)
+            .map(|(shape, z)| {
+                let m = z
+                    .material
+                    .as_deref()
+                    .and_then(|n| scene.material.index_of(n));
+                (shape, m.unwrap_or(0) as u32)
+            })
+            .collect();
         Ok(Model {
+            zones,
             boundaries: named_boundaries(scene),
             bodies,
-            material,
+            materials,
+            bulk: (m.all().iter())
+                .map(|m| m.young / (3.0 * (1.0 - 2.0 * m.poisson)))
+                .collect(),
             kernel,
-            body_force: [
-                m.density * scene.gravity.g[0],
-                m.density * scene.gravity.g[1],
-            ],
+            body_force: (m.all().iter())
+                .map(|m| {
+                    [
+                        m.density * scene.gravity.g[0],
+                        m.density * scene.gravity.g[1],
+                    ]
+                })
+                .collect(),
             tol: 1e-9 * size.max(1.0),
             scene: scene.clone(),
         })
     }
 
-    /// Whether the material can yield (Newton then backtracks).
+    /// Whether a material can yield (Newton then backtracks).
     pub fn plastic(&self) -> bool {
-        self.material.yields()
+        self.materials.iter().any(|m| m.yields())
     }
 
     /// The layout of every state row of the run.
     pub fn layout(&self) -> StateLayout {
-        self.material.layout()
+        self.materials[0].layout()
+    }
+
+    /// The laws of the materials at load factor `lambda`, in scene order.
+    pub fn laws(&self, lambda: f64) -> Vec<Law<'_>> {
+        (0..self.materials.len())
+            .map(|i| Law {
+                material: self.materials[i].as_ref(),
+                bulk: self.bulk[i],
+                body_force: self.body_force_at(i, lambda),
+            })
+            .collect()
     }
 
     pub fn mixed(&self) -> bool {
         matches!(self.kernel, Kernel::P2P1 { .. })
     }
 
-    /// The body force at load factor `lambda`: `density * g`, scaled by `lambda` under
-    /// `gravity.ramp`.
-    pub fn body_force_at(&self, lambda: f64) -> [f64; 2] {
+    /// The body force of material `material` at load factor `lambda`: `density * g`, scaled by
+    /// `lambda` under `gravity.ramp`.
+    pub fn body_force_at(&self, material: usize, lambda: f64) -> [f64; 2] {
+        let b = self.body_force[material];
         if self.scene.gravity.ramp {
-            self.body_force.map(|b| lambda * b)
+            b.map(|b| lambda * b)
         } else {
-            self.body_force
+            b
         }
     }
 

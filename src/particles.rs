@@ -25,6 +25,8 @@ pub struct Particles {
     /// material's layout each.
     pub state: Rows,
     pub flags: Vec<u32>,
+    /// Index of the particle's material in the scene's `[[material]]` list.
+    pub material: Vec<u32>,
 }
 
 /// Copies of other ranks' particles near ours, bit for bit, in the halo's ghost order.
@@ -37,11 +39,12 @@ pub struct Ghosts {
     pub increment: Vec<[f64; 2]>,
     pub h: Vec<f64>,
     pub state: Rows,
+    pub material: Vec<u32>,
 }
 
 /// f64 values per particle in a halo exchange before its state row: position, displacement,
-/// increment, h.
-const FIXED: usize = 7;
+/// increment, h, material index (exact in an f64).
+const FIXED: usize = 8;
 
 impl Particles {
     pub fn len(&self) -> usize {
@@ -70,6 +73,7 @@ impl Particles {
         self.h = order.iter().map(|&i| self.h[i]).collect();
         self.state = self.state.permuted(&order);
         self.flags = order.iter().map(|&i| self.flags[i]).collect();
+        self.material = order.iter().map(|&i| self.material[i]).collect();
     }
 
     /// f64 values per particle in [`Particles::records`].
@@ -85,6 +89,7 @@ impl Particles {
             out.extend_from_slice(&self.displacement[i]);
             out.extend_from_slice(&self.increment[i]);
             out.push(self.h[i]);
+            out.push(f64::from(self.material[i]));
             out.extend_from_slice(self.state.row(i));
         }
         out
@@ -104,6 +109,7 @@ impl Particles {
             p.displacement.push([r[2], r[3]]);
             p.increment.push([r[4], r[5]]);
             p.h.push(r[6]);
+            p.material.push(r[7] as u32);
             p.state.push(&r[FIXED..]);
         }
         p
@@ -125,6 +131,7 @@ impl Particles {
             g.displacement.push([r[2], r[3]]);
             g.increment.push([r[4], r[5]]);
             g.h.push(r[6]);
+            g.material.push(r[7] as u32);
             g.state.push(&r[FIXED..]);
         }
         Ok((halo, g))

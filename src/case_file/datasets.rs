@@ -33,10 +33,21 @@ pub fn columns(state_width: usize) -> [Column; 7] {
     ]
 }
 
+/// `/particles/material` (u32, n): each particle's index in the scene's `[[material]]` list.
+/// Written by every version-2 program; a file without it (version 1) has one material.
+pub fn material_column() -> Column {
+    Column {
+        name: "material",
+        width: 0,
+        dtype: u32::type_descriptor(),
+    }
+}
+
 /// Bytes of raw data per particle over all datasets.
 pub fn bytes_per_particle(state_width: usize) -> u64 {
     columns(state_width)
         .iter()
+        .chain([&material_column()])
         .map(|c| (c.width.max(1) * c.dtype.size()) as u64)
         .sum()
 }

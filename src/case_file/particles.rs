@@ -20,6 +20,8 @@ pub struct ParticleSet {
     pub state: Rows,
     /// Per-particle bit flags.
     pub flags: Vec<u32>,
+    /// Index of each particle's material in the scene's `[[material]]` list.
+    pub material: Vec<u32>,
 }
 
 impl ParticleSet {
@@ -33,6 +35,7 @@ impl ParticleSet {
             h: Vec::with_capacity(n),
             state: Rows::with_capacity(width, n),
             flags: Vec::with_capacity(n),
+            material: Vec::with_capacity(n),
         }
     }
 
@@ -44,7 +47,7 @@ impl ParticleSet {
         self.gid.is_empty()
     }
 
-    /// Appends a particle at rest: zero displacement, state and flags.
+    /// Appends a particle at rest: zero displacement, state, flags and material index.
     pub fn push_new(&mut self, gid: u64, position: [f64; 2], h: f64) {
         self.gid.push(gid);
         self.position.push(position);
@@ -53,6 +56,7 @@ impl ParticleSet {
         self.h.push(h);
         self.state.push_zeros();
         self.flags.push(0);
+        self.material.push(0);
     }
 
     /// The particles at indices `range`, copied.
@@ -64,7 +68,8 @@ impl ParticleSet {
             increment: self.increment[range.clone()].to_vec(),
             h: self.h[range.clone()].to_vec(),
             state: self.state.slice(range.clone()),
-            flags: self.flags[range].to_vec(),
+            flags: self.flags[range.clone()].to_vec(),
+            material: self.material[range].to_vec(),
         }
     }
 
@@ -77,6 +82,7 @@ impl ParticleSet {
         self.h.append(&mut other.h);
         self.state.append(&mut other.state);
         self.flags.append(&mut other.flags);
+        self.material.append(&mut other.material);
     }
 
     /// Names the first array whose length differs from `gid`'s.
@@ -89,6 +95,7 @@ impl ParticleSet {
             ("h", self.h.len()),
             ("state", self.state.len()),
             ("flags", self.flags.len()),
+            ("material", self.material.len()),
         ];
         match lens.iter().find(|(_, len)| *len != n) {
             Some((name, len)) => Err(format!(

@@ -173,6 +173,19 @@ pub fn check_particles(
                 ),
             ));
         }
+        let materials = scene.material.all().len();
+        if p.material[i] as usize >= materials {
+            return Err(bad(
+                path,
+                "dataset /particles/material",
+                format!(
+                    "{}: material {} of a scene with {materials} material{}",
+                    row(i),
+                    p.material[i],
+                    if materials == 1 { "" } else { "s" }
+                ),
+            ));
+        }
     }
     Ok(displaced)
 }

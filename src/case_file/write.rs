@@ -97,7 +97,8 @@ fn write_contents(
         state_columns::ATTR
     );
     step.step(&what, state_columns::put(&ds, names))?;
-    column_step(step, g, &flags, n, r, &local.flags).map(drop)
+    column_step(step, g, &flags, n, r.clone(), &local.flags)?;
+    column_step(step, g, &datasets::material_column(), n, r, &local.material).map(drop)
 }
 
 /// Collective. Writes a case file: every rank passes its own particles (any count, zero

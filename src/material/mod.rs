@@ -15,6 +15,7 @@
 
 pub mod elastic;
 pub mod layout;
+pub mod placed;
 pub mod tresca;
 
 pub use layout::{InternalVar, Rows, StateLayout, VarKind, STRESS_LEN};

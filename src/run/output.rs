@@ -210,6 +210,10 @@ fn point_data<'a>(
                 .collect(),
         ),
         Field::Scalar("rank".into(), vec![world.rank() as f64; p.len()]),
+        Field::Scalar(
+            "material".into(),
+            p.material.iter().map(|&m| f64::from(m)).collect(),
+        ),
     ];
     if layout.find("eps_q").is_none() {
         out.push(Field::Scalar("eps_q".into(), vec![0.0; p.len()]));

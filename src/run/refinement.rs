@@ -164,6 +164,9 @@ impl Simulation {
                     }
                 }
             }
+            // Between two materials the new particle takes the one of the end with the smaller
+            // global id: the same on every rank and for any partition.
+            let first = if mesh.gids[a] < mesh.gids[b] { a } else { b };
             born.push((
                 first_new + rank as u64,
                 x,
@@ -171,6 +174,7 @@ impl Simulation {
                 mid(incr(a), incr(b)),
                 0.5 * (mesh.h[a] + mesh.h[b]),
                 state,
+                self.point_material(mesh, first),
             ));
         }
         let p = &mut self.particles;
@@ -179,7 +183,7 @@ impl Simulation {
             p.displacement[i] = u;
             p.state.row_mut(i).copy_from_slice(&state);
         }
-        for (gid, x, u, du, h, state) in born {
+        for (gid, x, u, du, h, state, material) in born {
             p.gid.push(gid);
             p.position.push(x);
             p.displacement.push(u);
@@ -187,6 +191,7 @@ impl Simulation {
             p.h.push(h);
             p.state.push(&state);
             p.flags.push(0);
+            p.material.push(material);
         }
         let removed: HashSet<u64> = plan.remove.iter().map(|&r| mesh.gids[r as usize]).collect();
         if !removed.is_empty() {
@@ -198,6 +203,7 @@ impl Simulation {
             retain(&mut p.h, &keep);
             p.state.retain(&keep);
             retain(&mut p.flags, &keep);
+            retain(&mut p.material, &keep);
         }
         p.sort_by_gid();
         self.tri_states.forget_touching(&moved);

@@ -42,6 +42,7 @@ impl Simulation {
             h: p.h.clone(),
             state: p.state.clone(),
             flags: p.flags.iter().map(|f| f & !flag::TRACKED).collect(),
+            material: p.material.clone(),
         };
         let records = self.gauss_records();
         let mut header = self.header.clone();

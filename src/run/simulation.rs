@@ -92,6 +92,7 @@ impl Simulation {
             h: set.h,
             state: set.state,
             flags: set.flags,
+            material: set.material,
         };
         for (g, f) in particles.gid.iter().zip(particles.flags.iter_mut()) {
             if header.tracked_gids.contains(g) {

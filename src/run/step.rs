@@ -193,6 +193,46 @@ impl Simulation {
         }
     }
 
+    /// The material of each local triangle: that of the zone where the centroid of its
+    /// vertices' reference positions lies, so an interface drawn along triangle edges is kept
+    /// exactly and one across them is smeared by at most half a triangle. A triangle whose
+    /// reference centroid lies in no zone (its particles came together from far apart) takes
+    /// the material most of its vertices have, or where all three differ the one of its
+    /// smallest-gid vertex. Only data that every copy of a triangle has bit for bit decide, so
+    /// every rank gives it the same material.
+    pub(super) fn triangle_materials(&self, mesh: &LocalMesh) -> Vec<u32> {
+        if self.model.materials.len() == 1 {
+            return vec![0; mesh.tris.len()];
+        }
+        (0..mesh.tris.len())
+            .map(|t| {
+                let v = mesh.tris[t].map(|p| p as usize);
+                let x = v.map(|p| self.reference_position(mesh, p));
+                let c = [
+                    (x[0][0] + x[1][0] + x[2][0]) / 3.0,
+                    (x[0][1] + x[1][1] + x[2][1]) / 3.0,
+                ];
+                if let Some((_, m)) = self.model.zones.iter().find(|(z, _)| z.contains(c)) {
+                    return *m;
+                }
+                let m = v.map(|p| self.point_material(mesh, p));
+                if m[0] == m[1] || m[0] == m[2] {
+                    m[0]
+                } else if m[1] == m[2] {
+                    m[1]
+                } else {
+                    let first = (0..3).min_by_key(|&k| mesh.gids[v[k]]).unwrap_or(0);
+                    m[first]
+                }
+            })
+            .collect()
+    }
+
+    /// The material index of mesh point `p` (owned or ghost).
+    pub(super) fn point_material(&self, mesh: &LocalMesh, p: usize) -> u32 {
+        self.point_value(mesh, p, &self.particles.material, &self.ghosts.material)
+    }
+
     pub(super) fn point_value<T: Copy>(
         &self,
         mesh: &LocalMesh,
@@ -251,10 +291,10 @@ impl Simulation {
         self.add_contact_time(clock);
         let spacing = loads.spacing;
         let setup = StepSetup {
-            material: self.model.material.as_ref(),
+            laws: self.model.laws(to),
+            tri_law: self.triangle_materials(mesh),
             kernel: self.model.kernel,
             states_n,
-            body_force: self.model.body_force_at(to),
             constraints: &constraints,
             point_loads,
             contact: loads.pairs,

@@ -15,7 +15,8 @@ pub struct Scene {
     pub name: String,
     pub body: Body,
     pub mesh: Mesh,
-    pub material: Material,
+    /// `[material]`, or several named `[[material]]` tables that `body.zones` place.
+    pub material: Materials,
     /// Defaults to no gravity.
     #[serde(default)]
     pub gravity: Gravity,
@@ -91,6 +92,9 @@ pub struct Zone {
     /// Shown in messages; optional.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
+    /// The `[[material]]` this zone is made of (by name); optional with one material.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<String>,
     /// Vertices `[[x, y], ...]` (m) of a simple polygon, either orientation.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polygon: Option<Vec<[f64; 2]>>,
@@ -252,10 +256,78 @@ impl MaterialModel {
     }
 }
 
-/// `[material]`: one material for the whole body.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// The scene's materials: one `[material]` table, or an array of named `[[material]]` tables.
+/// The first is the scene's reference material: history columns normalised by cu, the contact
+/// penalty's stiffness scale and `info` read it (through `Deref`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Materials(pub Vec<Material>);
+
+impl std::ops::Deref for Materials {
+    type Target = Material;
+    fn deref(&self) -> &Material {
+        &self.0[0]
+    }
+}
+
+impl std::ops::DerefMut for Materials {
+    fn deref_mut(&mut self) -> &mut Material {
+        &mut self.0[0]
+    }
+}
+
+impl Materials {
+    pub fn all(&self) -> &[Material] {
+        &self.0
+    }
+
+    /// Index of the material called `name`.
+    pub fn index_of(&self, name: &str) -> Option<usize> {
+        self.0.iter().position(|m| m.name.as_deref() == Some(name))
+    }
+}
+
+impl Serialize for Materials {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        // One material stays a `[material]` table, as scenes were written before zones.
+        match self.0.as_slice() {
+            [one] => one.serialize(s),
+            many => many.serialize(s),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Materials {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = Materials;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a [material] table or [[material]] tables")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, a: A) -> Result<Materials, A::Error> {
+                let m = Material::deserialize(serde::de::value::MapAccessDeserializer::new(a))?;
+                Ok(Materials(vec![m]))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, a: A) -> Result<Materials, A::Error> {
+                let v =
+                    Vec::<Material>::deserialize(serde::de::value::SeqAccessDeserializer::new(a))?;
+                if v.is_empty() {
+                    return Err(serde::de::Error::custom("needs at least one material"));
+                }
+                Ok(Materials(v))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// One material: `[material]` for the whole body, or a named `[[material]]` of a zone.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
+    /// The name zones give in `material = "..."`; required with several materials.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
     /// `"linear-elastic"` or `"tresca"`.
     pub model: MaterialModel,
     /// Young's modulus (Pa), > 0.

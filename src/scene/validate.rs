@@ -5,7 +5,7 @@ use std::collections::HashSet;
 
 use super::field_path::FieldPath;
 use super::lattice::{self, generate_particles};
-use super::schema::{Dof, HistoryKind, MaterialModel, Scene, Selection};
+use super::schema::{Dof, HistoryKind, Material, MaterialModel, Scene, Selection};
 use super::selector::{Axis, Selector};
 
 /// Upper bound on the initial particle count, so that a mistyped `mesh.h` is reported instead
@@ -240,41 +240,7 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
         );
     }
 
-    let mat = root.join("material");
-    positive(mat.join("young"), s.material.young)?;
-    let nu = s.material.poisson;
-    if !(nu > -1.0 && nu < 0.5) {
-        return fail(
-            mat.join("poisson"),
-            format!("must be > -1 and < 0.5 (got {nu})"),
-        );
-    }
-    non_negative(mat.join("density"), s.material.density)?;
-    match s.material.model {
-        MaterialModel::Tresca => {
-            if !(s.material.cu > 0.0 && s.material.cu.is_finite()) {
-                return fail(
-                    mat.join("cu"),
-                    format!("must be > 0 for model \"tresca\" (got {})", s.material.cu),
-                );
-            }
-            cu_profile(s, &mat)?;
-        }
-        MaterialModel::LinearElastic => {
-            non_negative(mat.join("cu"), s.material.cu)?;
-            if s.material.cu_gradient != 0.0 || s.material.reference_level.is_some() {
-                let key = if s.material.cu_gradient != 0.0 {
-                    "cu_gradient"
-                } else {
-                    "reference_level"
-                };
-                return fail(
-                    mat.join(key),
-                    "is a parameter of model \"tresca\", not of \"linear-elastic\"".to_string(),
-                );
-            }
-        }
-    }
+    check_materials(s)?;
 
     finite2(root.join("gravity").join("g"), s.gravity.g)?;
 
@@ -553,10 +519,118 @@ pub fn validate(s: &Scene) -> Result<(), Invalid> {
     check_against_particles(s)
 }
 
+/// Every material's parameters; names (required, unique) with several; zones that name them.
+fn check_materials(s: &Scene) -> Result<(), Invalid> {
+    let all = s.material.all();
+    let root = FieldPath::key("material");
+    let at = |i: usize| {
+        if all.len() == 1 {
+            root.clone()
+        } else {
+            root.at(i)
+        }
+    };
+    for (i, m) in all.iter().enumerate() {
+        check_material(s, m, &at(i))?;
+        if all.len() > 1 {
+            match m.name.as_deref().map(str::trim) {
+                None | Some("") => {
+                    return fail(
+                        at(i).join("name"),
+                        "is required with several [[material]] tables: zones name their material"
+                            .to_string(),
+                    )
+                }
+                Some(n) if all[..i].iter().any(|o| o.name.as_deref() == Some(n)) => {
+                    return fail(at(i).join("name"), format!("\"{n}\" is given twice"));
+                }
+                _ => {}
+            }
+        }
+    }
+    let zones = FieldPath::key("body").join("zones");
+    for (i, z) in s.body.zones.iter().enumerate() {
+        match &z.material {
+            Some(name) if s.material.index_of(name).is_none() => {
+                let known: Vec<&str> = all.iter().filter_map(|m| m.name.as_deref()).collect();
+                let known = if known.is_empty() {
+                    "the [material] table has no `name`".to_string()
+                } else {
+                    format!("the materials are {}", known.join(", "))
+                };
+                return fail(
+                    zones.at(i).join("material"),
+                    format!("\"{name}\" names no [[material]]: {known}"),
+                );
+            }
+            None if all.len() > 1 => {
+                return fail(
+                    zones.at(i).join("material"),
+                    "is required with several [[material]] tables".to_string(),
+                )
+            }
+            _ => {}
+        }
+    }
+    if all.len() > 1 && s.body.zones.is_empty() {
+        return fail(
+            root,
+            "several materials need a body of [[body.zones]], each naming its material".to_string(),
+        );
+    }
+    if s.geostatic.is_some() && all.iter().any(|m| m.density != all[0].density) {
+        return fail(
+            FieldPath::key("geostatic"),
+            "takes one density for the whole body, but the materials' densities differ (the \
+             weight of layered zones is not integrated yet)"
+                .to_string(),
+        );
+    }
+    Ok(())
+}
+
+/// The parameters of one material, at `mat`.
+fn check_material(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
+    positive(mat.join("young"), m.young)?;
+    let nu = m.poisson;
+    if !(nu > -1.0 && nu < 0.5) {
+        return fail(
+            mat.join("poisson"),
+            format!("must be > -1 and < 0.5 (got {nu})"),
+        );
+    }
+    non_negative(mat.join("density"), m.density)?;
+    match m.model {
+        MaterialModel::Tresca => {
+            if !(m.cu > 0.0 && m.cu.is_finite()) {
+                return fail(
+                    mat.join("cu"),
+                    format!("must be > 0 for model \"tresca\" (got {})", m.cu),
+                );
+            }
+            cu_profile(s, m, mat)
+        }
+        MaterialModel::LinearElastic => {
+            non_negative(mat.join("cu"), m.cu)?;
+            if m.cu_gradient != 0.0 || m.reference_level.is_some() {
+                let key = if m.cu_gradient != 0.0 {
+                    "cu_gradient"
+                } else {
+                    "reference_level"
+                };
+                return fail(
+                    mat.join(key),
+                    "is a parameter of model \"tresca\", not of \"linear-elastic\"".to_string(),
+                );
+            }
+            Ok(())
+        }
+    }
+}
+
 /// A Tresca strength profile: a finite gradient with its reference level, and cu > 0 down to the
 /// lowest point of the body.
-fn cu_profile(s: &Scene, mat: &FieldPath) -> Result<(), Invalid> {
-    let m = &s.material;
+fn cu_profile(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
     let k = m.cu_gradient;
     if !k.is_finite() {
         return fail(mat.join("cu_gradient"), format!("must be finite (got {k})"));

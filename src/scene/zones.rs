@@ -152,8 +152,20 @@ pub fn fill(scene: &Scene, width: usize) -> ParticleSet {
     let Ok(points) = geometry::fill_zones(&shapes, &params) else {
         return set;
     };
+    // A particle on the boundary of two zones belongs to the lower-indexed one (the fill's
+    // rule), and so does its material.
+    let material: Vec<u32> = (scene.body.zones.iter())
+        .map(|z| {
+            let m = z
+                .material
+                .as_deref()
+                .and_then(|n| scene.material.index_of(n));
+            m.unwrap_or(0) as u32
+        })
+        .collect();
     for (gid, p) in points.iter().enumerate() {
         set.push_new(gid as u64, p.position, p.h);
+        set.material[gid] = material[p.zone];
     }
     set
 }

@@ -12,5 +12,5 @@ pub mod split;
 
 pub use constraints::Constraints;
 pub use dofs::DofMap;
-pub use problem::{CoarseOperator, Kernel, SchurPreconditioner, StepProblem, StepSetup};
+pub use problem::{CoarseOperator, Kernel, Law, SchurPreconditioner, StepProblem, StepSetup};
 pub use split::FieldLayout;

@@ -29,16 +29,28 @@ pub enum Kernel {
     /// Taylor–Hood P2–P1 with vertex pressures for nearly incompressible and plastically
     /// incompressible soil. The pressure unknown is p / `scale` (scale = G/h), which has the size
     /// of a displacement and keeps the saddle point well conditioned.
-    P2P1 { bulk: f64, scale: f64 },
+    P2P1 { scale: f64 },
+}
+
+/// What one material brings to its triangles.
+#[derive(Clone, Copy)]
+pub struct Law<'a> {
+    pub material: &'a dyn Material,
+    /// Bulk modulus of the mixed kernel's pressure–volume relation (Pa).
+    pub bulk: f64,
+    /// Body force per unit volume (N/m³) at the step's end.
+    pub body_force: [f64; 2],
 }
 
 /// What a step needs besides the mesh.
 pub struct StepSetup<'a> {
-    pub material: &'a dyn Material,
+    /// The materials' laws, in the scene's order.
+    pub laws: Vec<Law<'a>>,
+    /// Index into `laws` of each local triangle.
+    pub tri_law: Vec<u32>,
     pub kernel: Kernel,
     /// Cauchy state at the start of the step, per local triangle and Gauss point.
     pub states_n: &'a StartStates,
-    pub body_force: [f64; 2],
     pub constraints: &'a Constraints,
     /// Total external point forces on owned nodes at the end of the step: (node, force).
     pub point_loads: Vec<(u32, [f64; 2])>,
@@ -48,6 +60,13 @@ pub struct StepSetup<'a> {
     /// Follower pressures on boundary edges touching an owned node: nodes [a, m, b] (body on
     /// the left of a→b) and the pressure.
     pub surface: Vec<([u32; 3], f64)>,
+}
+
+impl StepSetup<'_> {
+    /// The law of local triangle `t`.
+    pub fn law(&self, t: usize) -> Law<'_> {
+        self.laws[self.tri_law[t] as usize]
+    }
 }
 
 /// What an augmentation of the contact multipliers changed (this rank's share).
@@ -332,7 +351,7 @@ impl<'a> StepProblem<'a> {
                 self.dofs.node_owned[node] && self.setup.constraints.is_fixed(node, k % 2)
             })
         };
-        let width = POINTS * self.setup.material.layout().len();
+        let width = POINTS * self.setup.laws[0].material.layout().len();
         let mut out = Converged {
             states: Rows::with_capacity(width, self.n_triangles()),
             residuals: Vec::new(),
@@ -375,6 +394,7 @@ impl<'a> StepProblem<'a> {
         tangent: bool,
     ) -> Result<ElementResult, String> {
         let s = &self.setup;
+        let law = s.law(t);
         let at = |k: usize| local[self.local_dof(t, k)];
         let du: [[f64; 2]; 6] = std::array::from_fn(|k| [at(2 * k), at(2 * k + 1)]);
         let geometry = self.geometry(t);
@@ -384,8 +404,8 @@ impl<'a> StepProblem<'a> {
                 &geometry,
                 &du,
                 &s.states_n.get(t),
-                s.material,
-                s.body_force,
+                law.material,
+                law.body_force,
                 tangent,
             )
             .map(|e| ElementResult {
@@ -393,16 +413,16 @@ impl<'a> StepProblem<'a> {
                 tangent: flat(e.tangent.as_flattened()),
                 states: e.states,
             }),
-            Kernel::P2P1 { bulk, scale } => {
+            Kernel::P2P1 { scale } => {
                 let p: [f64; 3] = std::array::from_fn(|k| scale * at(12 + k));
                 p2p1_element(
                     &geometry,
                     &du,
                     &p,
                     &s.states_n.get(t),
-                    s.material,
-                    bulk,
-                    s.body_force,
+                    law.material,
+                    law.bulk,
+                    law.body_force,
                 )
                 .map(|e| {
                     let e = e.with_pressure_scale(scale);
@@ -819,7 +839,7 @@ impl NonlinearProblem for StepProblem<'_> {
             if let Some(y) = yielded.as_mut() {
                 // Each triangle once over the ranks: its owner lists it.
                 let start = self.setup.states_n.get(t);
-                let material = self.setup.material;
+                let material = self.setup.law(t).material;
                 if self.mesh.tri_owned[t]
                     && e.states
                         .iter()
@@ -987,7 +1007,7 @@ impl StepProblem<'_> {
         schur: &SchurPreconditioner,
         local: &[f64],
     ) -> Result<(), PetscError> {
-        let Kernel::P2P1 { bulk, scale } = self.setup.kernel else {
+        let Kernel::P2P1 { scale } = self.setup.kernel else {
             return Ok(());
         };
         let m = schur.matrix.as_ref();
@@ -1001,11 +1021,12 @@ impl StepProblem<'_> {
             }
             let du: [[f64; 2]; 6] = std::array::from_fn(|k| self.node_u(local, nodes[k] as usize));
             let x = &self.geometry(t);
+            let Law { material, bulk, .. } = self.setup.law(t);
             let g = super::split::effective_shear_modulus(
                 x,
                 &du,
                 &self.setup.states_n.get(t),
-                self.setup.material,
+                material,
             )
             .unwrap_or(f64::INFINITY);
             let area = crate::fem::p1::area(&[x[0], x[1], x[2]]);
