@@ -79,6 +79,12 @@ fn new(world: &Comm, scene: &str, out: &std::path::Path, sets: &[String]) -> Res
     }
     write_case(world, out, &header, &set)?;
     if world.rank() == 0 {
+        for name in crate::scene::zones::unused_materials(&scene_v) {
+            eprintln!(
+                "pfem-mpi: warning: scene '{scene}': [[material]] \"{name}\" is named by no \
+                 body.zones entry"
+            );
+        }
         println!(
             "wrote {} ({} particles, scene {})",
             out.display(),

@@ -17,6 +17,10 @@ pub const BUILTINS: &[(&str, &str)] = &[
     ("tbar-rough", include_str!("builtin/tbar-rough.toml")),
     ("pipeline", include_str!("builtin/pipeline.toml")),
     ("vertical-cut", include_str!("builtin/vertical-cut.toml")),
+    (
+        "footing-layered",
+        include_str!("builtin/footing-layered.toml"),
+    ),
 ];
 
 /// TOML text of the built-in scene `name`.

@@ -170,6 +170,18 @@ pub fn fill(scene: &Scene, width: usize) -> ParticleSet {
     set
 }
 
+/// The names of the `[[material]]` tables that no zone names (with several materials).
+pub fn unused_materials(scene: &Scene) -> Vec<String> {
+    let all = scene.material.all();
+    if all.len() < 2 {
+        return Vec::new();
+    }
+    all.iter()
+        .filter_map(|m| m.name.clone())
+        .filter(|n| !scene.body.zones.iter().any(|z| z.material.as_deref() == Some(n)))
+        .collect()
+}
+
 /// Total area of the zones (they do not overlap).
 pub fn area(scene: &Scene) -> f64 {
     shapes(scene)
