@@ -53,16 +53,32 @@ pub fn render(
     match &scene {
         Ok(sc) => {
             line("scene", format!("{} (from {})", sc.name, h.scene_source));
-            let mut model = format!(
-                "{}, E = {} Pa, nu = {}",
-                sc.material.model.as_str(),
-                num(sc.material.young),
-                num(sc.material.poisson)
-            );
-            if sc.material.model == crate::scene::MaterialModel::Tresca {
-                let _ = write!(model, ", cu = {} Pa", num(sc.material.cu));
+            for m in sc.material.all() {
+                let mut model = match &m.name {
+                    Some(n) => format!("\"{n}\": "),
+                    None => String::new(),
+                };
+                let _ = write!(
+                    model,
+                    "{}, E = {} Pa, nu = {}",
+                    m.model.as_str(),
+                    num(m.young),
+                    num(m.poisson)
+                );
+                if m.model == crate::scene::MaterialModel::Tresca {
+                    let _ = write!(model, ", cu = {} Pa", num(m.cu));
+                    if m.cu_gradient != 0.0 {
+                        let level = m.reference_level.unwrap_or(f64::NAN);
+                        let _ = write!(
+                            model,
+                            " growing {} Pa/m below y = {} m",
+                            num(m.cu_gradient),
+                            num(level)
+                        );
+                    }
+                }
+                line("material", model);
             }
-            line("material", model);
             let mut mesh = format!("h = {} m, alpha = {}", num(sc.mesh.h), num(sc.mesh.alpha));
             if let Some(a) = &sc.mesh.adapt {
                 let _ = write!(
