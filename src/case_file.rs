@@ -145,12 +145,18 @@ pub fn new_case(scene: &Scene, source: &str) -> (CaseHeader, ParticleSet) {
     }
     if let Some(g) = &scene.geostatic {
         let gamma = scene.material.density * scene.gravity.g[0].hypot(scene.gravity.g[1]);
+        let shapes = crate::scene::zones::shapes(scene).unwrap_or_default();
         for (x, state) in particles.position.iter().zip(particles.state.iter_mut()) {
             // Compression negative; the Gauss-state layout starts with σxx, σyy, σzz, σxy.
-            let sv = -(g.surcharge + gamma * (g.surface - x[1]).max(0.0));
-            state[0] = g.k0 * sv;
+            let [sh, sv] = if shapes.is_empty() {
+                let sv = -(g.surcharge + gamma * (g.surface - x[1]).max(0.0));
+                [g.k0 * sv, sv]
+            } else {
+                crate::scene::zones::geostatic(scene, &shapes, *x, g)
+            };
+            state[0] = sh;
             state[1] = sv;
-            state[2] = g.k0 * sv;
+            state[2] = sh;
         }
     }
     let header = CaseHeader {

@@ -512,3 +512,126 @@ fn zones_of_equal_strength_give_the_single_material_answer() {
     );
     assert!(p.iter().any(|q| q.2 == 1) && p.iter().any(|q| q.2 == 0));
 }
+
+/// A column of three elastic layers of different densities and K0, under its own weight from
+/// the geostatic state: every particle's σyy is the weight of the layers above it.
+const COLUMN: &str = r#"
+name = "layered-column"
+[body]
+zones = [
+  { name = "bottom", material = "dense", k0 = 0.8, rectangle = { origin = [0.0, 0.0], size = [1.0, 2.0] } },
+  { name = "middle", material = "medium", rectangle = { origin = [0.0, 2.0], size = [1.0, 1.5] } },
+  { name = "top", material = "light", k0 = 0.5, rectangle = { origin = [0.0, 3.5], size = [1.0, 1.5] } },
+]
+[mesh]
+h = 0.25
+[[material]]
+name = "dense"
+model = "linear-elastic"
+young = 5.0e7
+poisson = 0.3
+density = 2100.0
+[[material]]
+name = "medium"
+model = "linear-elastic"
+young = 3.0e7
+poisson = 0.3
+density = 1800.0
+[[material]]
+name = "light"
+model = "linear-elastic"
+young = 1.0e7
+poisson = 0.3
+density = 1500.0
+[gravity]
+g = [0.0, -9.81]
+[geostatic]
+surface = 5.0
+k0 = 0.6
+[[fixed]]
+where = "y <= 0"
+dofs = ["x", "y"]
+[[fixed]]
+where = "x <= 0"
+dofs = ["x"]
+[[fixed]]
+where = "x >= 1"
+dofs = ["x"]
+[steps]
+count = 10
+[history]
+columns = [{ name = "load_factor", measure = "load_factor" }]
+"#;
+
+/// The exact vertical stress at height y: the weight of the layers above.
+fn column_weight(y: f64) -> f64 {
+    let g = 9.81;
+    let above = |lo: f64, hi: f64| (hi - y.max(lo)).max(0.0);
+    -g * (2100.0 * above(0.0, 2.0) + 1800.0 * above(2.0, 3.5) + 1500.0 * above(3.5, 5.0))
+}
+
+/// (x0, y0, σxx, σyy) of every particle of a case file.
+fn column_stresses(file: &Path) -> Vec<[f64; 4]> {
+    let script = format!(
+        "import h5py\nf = h5py.File({:?}, 'r')\ns = f['particles/state'][...]\n\
+         x = f['particles/position'][...] - f['particles/displacement'][...]\n\
+         for i in range(len(s)): print(x[i, 0], x[i, 1], s[i, 0], s[i, 1])",
+        file.display().to_string()
+    );
+    let out = std::process::Command::new("python3")
+        .args(["-c", &script])
+        .output()
+        .expect("python3");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2], v[3]]
+        })
+        .collect()
+}
+
+#[test]
+fn a_layered_column_carries_the_weight_of_the_layers_above() {
+    let dir = workdir("layered-column");
+    std::fs::write(dir.join("column.toml"), COLUMN).unwrap();
+    ok(&dir, 1, &["new", "column.toml", "-o", "c.h5"]);
+    let scale = -column_weight(0.0);
+    for (what, file) in [
+        ("geostatic state", dir.join("c.h5")),
+        ("after 10 steps", {
+            ok(&dir, 2, &["c.h5", "--out", "r"]);
+            dir.join("r/checkpoints/step_000010.h5")
+        }),
+    ] {
+        let mut worst: f64 = 0.0;
+        for [_, y, sxx, syy] in column_stresses(&file) {
+            worst = worst.max((syy - column_weight(y)).abs() / scale);
+            // K0 of the layer (0.8, geostatic.k0 = 0.6, 0.5), on the first step away from the
+            // interfaces whose particles belong to the layer below.
+            if what == "geostatic state" {
+                let k0 = if y < 2.0 {
+                    0.8
+                } else if y < 3.5 {
+                    0.6
+                } else {
+                    0.5
+                };
+                let interface = [2.0, 3.5].iter().any(|l| (y - l).abs() < 1e-9);
+                if !interface && y < 5.0 {
+                    assert!(
+                        (sxx - k0 * column_weight(y)).abs() <= 1e-12 * scale,
+                        "σxx at {y}"
+                    );
+                }
+            }
+        }
+        println!("{what}: largest |σyy − weight above| / weight at the base = {worst:.2e}");
+        assert!(worst < 1e-10, "{what}: {worst:e}");
+    }
+}

@@ -95,6 +95,9 @@ pub struct Zone {
     /// The `[[material]]` this zone is made of (by name); optional with one material.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
+    /// This zone's coefficient of earth pressure at rest, instead of `geostatic.k0`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k0: Option<f64>,
     /// Vertices `[[x, y], ...]` (m) of a simple polygon, either orientation.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polygon: Option<Vec<[f64; 2]>>,

@@ -578,13 +578,33 @@ fn check_materials(s: &Scene) -> Result<(), Invalid> {
             "several materials need a body of [[body.zones]], each naming its material".to_string(),
         );
     }
-    if s.geostatic.is_some() && all.iter().any(|m| m.density != all[0].density) {
+    if s.geostatic.is_some()
+        && s.body.zones.is_empty()
+        && all.iter().any(|m| m.density != all[0].density)
+    {
         return fail(
             FieldPath::key("geostatic"),
-            "takes one density for the whole body, but the materials' densities differ (the \
-             weight of layered zones is not integrated yet)"
+            "takes one density for a body of rectangles, but the materials' densities differ"
                 .to_string(),
         );
+    }
+    for (i, z) in s.body.zones.iter().enumerate() {
+        if let Some(k0) = z.k0 {
+            if !(k0.is_finite() && k0 >= 0.0) {
+                return fail(
+                    FieldPath::key("body").join("zones").at(i).join("k0"),
+                    format!("must be >= 0 and finite (got {k0})"),
+                );
+            }
+            if s.geostatic.is_none() {
+                return fail(
+                    FieldPath::key("body").join("zones").at(i).join("k0"),
+                    "needs [geostatic]: it is the zone's horizontal-to-vertical ratio of the \
+                     geostatic stress"
+                        .to_string(),
+                );
+            }
+        }
     }
     Ok(())
 }

@@ -178,8 +178,75 @@ pub fn unused_materials(scene: &Scene) -> Vec<String> {
     }
     all.iter()
         .filter_map(|m| m.name.clone())
-        .filter(|n| !scene.body.zones.iter().any(|z| z.material.as_deref() == Some(n)))
+        .filter(|n| {
+            !scene
+                .body
+                .zones
+                .iter()
+                .any(|z| z.material.as_deref() == Some(n))
+        })
         .collect()
+}
+
+/// Length of the vertical segment from (x, y0) up to (x, y1) inside `shape`.
+pub fn vertical_length_inside(shape: &Shape, x: f64, y0: f64, y1: f64) -> f64 {
+    let clip = |lo: f64, hi: f64| (hi.min(y1) - lo.max(y0)).max(0.0);
+    match shape {
+        Shape::Circle(c) => {
+            let (cx, r) = (c.centre(), c.radius());
+            let half = (r * r - (x - cx[0]).powi(2)).max(0.0).sqrt();
+            clip(cx[1] - half, cx[1] + half)
+        }
+        Shape::Rectangle(r) => {
+            let (o, s) = (r.origin(), r.size());
+            if x < o[0] || x > o[0] + s[0] {
+                0.0
+            } else {
+                clip(o[1], o[1] + s[1])
+            }
+        }
+        Shape::Polygon(p) => {
+            // Where the line crosses the rings; an edge counts when it straddles x, one end
+            // on each side by the half-open rule, so a vertex on the line counts once.
+            let mut ys: Vec<f64> = Vec::new();
+            for ring in std::iter::once(p.outer()).chain(p.holes().iter().map(|h| h.as_slice())) {
+                for k in 0..ring.len() {
+                    let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
+                    if (a[0] <= x) != (b[0] <= x) {
+                        ys.push(a[1] + (x - a[0]) * (b[1] - a[1]) / (b[0] - a[0]));
+                    }
+                }
+            }
+            ys.sort_by(f64::total_cmp);
+            ys.chunks_exact(2).map(|c| clip(c[0], c[1])).sum()
+        }
+    }
+}
+
+/// The geostatic vertical and horizontal stress (compression negative) at `x` of a zone body:
+/// the surcharge plus the weight of every zone between `x` and the level `surface` (each with
+/// its material's density), and the horizontal stress from the K0 of the zone holding `x` (the
+/// first, on a boundary zones share, as for its particle's material).
+pub fn geostatic(
+    scene: &Scene,
+    shapes: &[Shape],
+    x: [f64; 2],
+    g: &super::rigid::Geostatic,
+) -> [f64; 2] {
+    let gravity = scene.gravity.g[0].hypot(scene.gravity.g[1]);
+    let mut weight = 0.0;
+    for (shape, zone) in shapes.iter().zip(&scene.body.zones) {
+        let m = zone
+            .material
+            .as_deref()
+            .and_then(|n| scene.material.index_of(n));
+        let density = scene.material.all()[m.unwrap_or(0)].density;
+        weight += density * gravity * vertical_length_inside(shape, x[0], x[1], g.surface);
+    }
+    let holder = shapes.iter().position(|s| s.contains(x));
+    let k0 = holder.and_then(|z| scene.body.zones[z].k0).unwrap_or(g.k0);
+    let sv = -(g.surcharge + weight);
+    [k0 * sv, sv]
 }
 
 /// Total area of the zones (they do not overlap).
