@@ -7,6 +7,7 @@ pub mod delaunay;
 pub mod fingerprint;
 pub mod local;
 pub mod near_ties;
+pub mod notches;
 pub mod predicates;
 pub mod refine;
 
