@@ -200,12 +200,12 @@ mod tests {
 
     #[test]
     fn separate_surfaces_still_merge() {
-        // Two blocks side by side one spacing apart: their facing boundaries are not adjacent
-        // on the previous boundary, so the triangles that join them are kept.
+        // Two 4 x 5 blocks four spacings apart, then moved together: their facing boundaries
+        // are not adjacent on the previous boundary, so the triangles that join them are kept.
         let mut pts = Vec::new();
         for j in 0..5 {
-            for i in 0..9 {
-                if i != 4 {
+            for i in 0..11 {
+                if i <= 3 || i >= 7 {
                     pts.push([i as f64, j as f64]);
                 }
             }
@@ -222,15 +222,15 @@ mod tests {
         };
         let before = mesh(&pts);
         let local: Vec<[u32; 3]> = before.iter().map(|k| k.map(|g| g as u32)).collect();
-        assert_eq!(boundary_edges(&local).len(), 2 * 16, "two separate blocks");
+        assert_eq!(boundary_edges(&local).len(), 2 * 14, "two separate blocks");
         let out = boundary_out_edges(before.iter(), |_| true);
-        // The right block moves left by one spacing: the gap closes.
+        // The right block moves left by three spacings: one lattice of 8 x 5.
         for p in pts.iter_mut().filter(|p| p[0] > 4.0) {
-            p[0] -= 1.0;
+            p[0] -= 3.0;
         }
         let after = mesh(&pts);
         let was = |a: u64, b: u64| out.binary_search(&[a, b]).is_ok();
-        assert!(after.len() > before.len());
+        assert_eq!(after.len(), 2 * 7 * 4);
         assert!(after.iter().all(|k| !closes_notch(*k, was)));
     }
 }
