@@ -91,8 +91,11 @@ fn slope() -> (String, Shape) {
     (text, shape)
 }
 
-/// Reference positions and triangles of every field frame of a run folder, in step order.
-fn frames(dir: &Path) -> Vec<(Vec<[f64; 2]>, Vec<[usize; 3]>)> {
+/// A field frame: reference positions and triangles.
+type Frame = (Vec<[f64; 2]>, Vec<[usize; 3]>);
+
+/// Every field frame of a run folder, in step order.
+fn frames(dir: &Path) -> Vec<Frame> {
     let script = "import h5py, os, sys\nd = sys.argv[1]\n\
         for n in sorted(os.listdir(d)):\n    \
         f = h5py.File(os.path.join(d, n), 'r')\n    \

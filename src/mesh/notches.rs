@@ -189,7 +189,7 @@ mod tests {
         assert_eq!(closing.len(), 1);
         assert!(!first.contains(closing[0]));
         // Out edges restricted to owned starts are those of the full list starting there.
-        let owned = |g: u64| g % 3 == 0;
+        let owned = |g: u64| g.is_multiple_of(3);
         let part = boundary_out_edges(keys.iter().filter(|k| k.iter().any(|&g| owned(g))), owned);
         let whole: Vec<[u64; 2]> = boundary_out_edges(keys.iter(), |_| true)
             .into_iter()
