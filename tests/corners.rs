@@ -1,8 +1,8 @@
 //! Bodies drawn as polygons mesh without spurious triangles at their concave corners (issue 27
 //! item 3): at a re-entrant corner or a polygonal hole the alpha shape alone keeps a triangle of
 //! circumradius s/√2 across the notch. The meshes of the first two steps cover exactly the drawn
-//! body (area to round-off, boundary edges on the polygon), on 1 and 2 ranks, and the first mesh
-//! is the same on 1, 2 and 3 ranks.
+//! body (area to round-off, boundary edges on the polygon), on 1 and 2 ranks, and the first and
+//! the last mesh are the same on 1, 2 and 3 ranks.
 
 mod common;
 use common::*;
@@ -197,21 +197,13 @@ fn assert_covers(what: &str, shape: &Shape, x: &[[f64; 2]], tris: &[[usize; 3]])
 }
 
 /// Writes `text`, meshes it on 1, 2, 3 ranks (same fingerprint), runs two steps on 1 and 2
-/// ranks and checks both steps' meshes against `shape`.
+/// ranks, checks both steps' meshes against `shape`, and meshes the last checkpoint on 1, 2, 3
+/// ranks (same fingerprint).
 fn check_scene(name: &str, text: &str, shape: &Shape) {
     let dir = workdir(name);
     std::fs::write(dir.join("s.toml"), text).unwrap();
     ok(&dir, 1, &["new", "s.toml", "-o", "s.h5"]);
-    let prints: Vec<String> = [1, 2, 3]
-        .iter()
-        .map(|&n| ok(&dir, n, &["mesh", "s.h5"]).trim().to_string())
-        .collect();
-    println!("{name}: {}", prints[0]);
-    assert!(prints[0].starts_with("fingerprint "));
-    assert!(
-        prints.iter().all(|p| p == &prints[0]),
-        "{name}: fingerprints differ on 1, 2, 3 ranks: {prints:#?}"
-    );
+    same_mesh_on_1_2_3_ranks(&dir, "s.h5");
     let mut counts = Vec::new();
     for ranks in [1, 2] {
         let out = format!("r{ranks}");
@@ -229,6 +221,21 @@ fn check_scene(name: &str, text: &str, shape: &Shape) {
         }
     }
     assert!(counts.iter().all(|&c| c == counts[0]), "{counts:?}");
+    // The mesh after the last step, from the previous mesh's boundary held in the checkpoint.
+    same_mesh_on_1_2_3_ranks(&dir, "r1/checkpoints/step_000002.h5");
+}
+
+fn same_mesh_on_1_2_3_ranks(dir: &Path, file: &str) {
+    let prints: Vec<String> = [1, 2, 3]
+        .iter()
+        .map(|&n| ok(dir, n, &["mesh", file]).trim().to_string())
+        .collect();
+    println!("{file}: {}", prints[0]);
+    assert!(prints[0].starts_with("fingerprint "));
+    assert!(
+        prints.iter().all(|p| p == &prints[0]),
+        "{file}: fingerprints differ on 1, 2, 3 ranks: {prints:#?}"
+    );
 }
 
 #[test]

@@ -1,5 +1,5 @@
-//! Meshing of the particle cloud: exact predicates, Delaunay, alpha shape, the rank-local mesh,
-//! refinement and the rank-count independent fingerprint.
+//! Meshing of the particle cloud: exact predicates, Delaunay, alpha shape and its notch rules, the
+//! rank-local mesh, refinement and the rank-count independent fingerprint.
 
 pub mod adapt;
 pub mod alpha;
