@@ -248,3 +248,24 @@ fn a_slope_a_step_and_a_round_hole_mesh_exactly() {
     let (text, shape) = slope();
     check_scene("corners-slope", &text, &shape);
 }
+
+/// A body of rectangles whose union is an L (2 x 1 below, 1 x 1 on its left half above, h =
+/// 0.1): the first mesh is the 300 lattice cells, two triangles each, and its boundary the
+/// 80 edges of the L's perimeter; the alpha shape alone bridged the corner with a 601st.
+#[test]
+fn an_l_of_rectangles_meshes_to_its_cells() {
+    let dir = workdir("corners-rectangles");
+    let l = "body.rectangles=[{origin=[0.0,0.0],size=[2.0,1.0]},{origin=[0.0,1.0],size=[1.0,1.0]}]";
+    ok(
+        &dir,
+        1,
+        &["new", "block-compression", "-o", "l.h5", "--set", l],
+    );
+    for ranks in [1, 2] {
+        let line = ok(&dir, ranks, &["mesh", "l.h5"]);
+        assert!(
+            line.contains("particles 341 triangles 600 boundary_edges 80"),
+            "{ranks} rank(s): {line}"
+        );
+    }
+}
