@@ -37,8 +37,8 @@ impl Simulation {
     ) -> usize {
         let rank = world.rank();
         let gid = &self.particles.gid;
-        // Boundary edges leaving each owned particle: at most 2 but at a vertex where two loops
-        // touch, a handful where several do; the exchange's stride is the largest anywhere.
+        // Boundary edges leaving each owned particle: one on a boundary loop, more where loops
+        // touch at a vertex; the exchange's stride is the largest count anywhere.
         let from = |g: u64| {
             let lo = previous.partition_point(|e| e[0] < g);
             let hi = previous.partition_point(|e| e[0] <= g);
@@ -70,6 +70,7 @@ impl Simulation {
                 *slot = e[1];
             }
         }
+        // `build_mesh` has just set the halo on every rank, so all take the same branch here.
         let Some(halo) = self.halo.as_ref() else {
             return 0;
         };
