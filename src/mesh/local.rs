@@ -133,6 +133,22 @@ impl LocalMesh {
         removed
     }
 
+    /// Removes triangle `t` where `drop[t]`; `drop` must be decided from data every rank holding
+    /// the triangle has alike. Returns how many were removed.
+    pub fn drop_flagged(&mut self, rank: i32, drop: &[bool]) -> usize {
+        let before = self.tris.len();
+        let mut t = 0;
+        self.tris.retain(|_| {
+            t += 1;
+            !drop.get(t - 1).copied().unwrap_or(false)
+        });
+        let removed = before - self.tris.len();
+        if removed > 0 {
+            self.derive(rank);
+        }
+        removed
+    }
+
     /// The triangle's global-id key (smallest gid first, CCW).
     pub fn tri_key(&self, t: usize) -> [u64; 3] {
         key(&self.tris[t], &self.gids)

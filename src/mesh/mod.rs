@@ -1,5 +1,5 @@
-//! Meshing of the particle cloud: exact predicates, Delaunay, alpha shape, the rank-local mesh,
-//! refinement and the rank-count independent fingerprint.
+//! Meshing of the particle cloud: exact predicates, Delaunay, alpha shape and its notch rules, the
+//! rank-local mesh, refinement and the rank-count independent fingerprint.
 
 pub mod adapt;
 pub mod alpha;
@@ -7,6 +7,7 @@ pub mod delaunay;
 pub mod fingerprint;
 pub mod local;
 pub mod near_ties;
+pub mod notches;
 pub mod predicates;
 pub mod refine;
 

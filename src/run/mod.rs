@@ -1,6 +1,7 @@
 //! The PFEM step loop (the method's Fig. 1): remesh, map, solve, update, output, checkpoint.
 
 mod adapt;
+mod boundary_rules;
 mod contact;
 mod error;
 mod node_values;

@@ -151,16 +151,23 @@ impl Simulation {
     /// Collective. Delaunay of owned particles plus halo, alpha shape, triangles around owned
     /// particles; the spacings adapted first where `[mesh.adapt]` asks.
     pub fn remesh(&mut self, world: &Comm) -> Result<LocalMesh, RunError> {
-        let mut mesh = self.build_mesh(world)?;
+        // The previous mesh's boundary, before refinement forgets triangles of `tri_states`.
+        let previous = self.previous_boundary();
+        let mut mesh = self.build_mesh(world, &previous)?;
         self.adapt_spacing(world, &mut mesh);
         if self.refine(world, &mesh)? {
-            return self.build_mesh(world);
+            return self.build_mesh(world, &previous);
         }
         Ok(mesh)
     }
 
-    /// Collective. The mesh of the current particles, without refinement.
-    pub(super) fn build_mesh(&mut self, world: &Comm) -> Result<LocalMesh, RunError> {
+    /// Collective. The mesh of the current particles, without refinement; `previous` is the last
+    /// mesh's boundary (`previous_boundary`), whose notches the new mesh keeps open.
+    pub(super) fn build_mesh(
+        &mut self,
+        world: &Comm,
+        previous: &[[u64; 2]],
+    ) -> Result<LocalMesh, RunError> {
         let h_max = max_f64(world, self.particles.h.iter().copied().fold(0.0, f64::max));
         let width = halo_width(self.model.scene.mesh.alpha, h_max);
         let (halo, ghosts) = self.particles.ghosts(world, width)?;
@@ -192,6 +199,7 @@ impl Simulation {
             mesh = LocalMesh::build(points, gids, owner, h, n, rank, alpha, false)?;
         }
         self.drop_crossing(&mut mesh, rank);
+        self.respect_boundary(world, &mut mesh, previous);
         Ok(mesh)
     }
 
@@ -332,7 +340,8 @@ impl Simulation {
     /// mesh, the Newton predictor at its nodes and the contact state go with the particles (by
     /// triangle and node key, as on restart), so a repartition does not change the results.
     fn repartition(&mut self, world: &Comm, mode: Repartition) -> Result<(), RunError> {
-        let mesh = self.build_mesh(world)?;
+        let previous = self.previous_boundary();
+        let mesh = self.build_mesh(world, &previous)?;
         let n = mesh.n_owned;
         let mut adj: Vec<Vec<u64>> = vec![Vec::new(); n];
         for t in &mesh.tris {
