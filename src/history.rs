@@ -54,9 +54,23 @@ pub fn row(scene: &Scene, m: &Measures) -> Result<Vec<f64>, String> {
         Some(kind) => kind_row(scene, kind, m)?,
         None => Vec::new(),
     };
-    for c in &scene.history.columns {
+    // A row that is not a number is a result no one can use: the run stops on it.
+    for (v, name) in values.iter().zip(header(scene).iter().skip(1)) {
+        if !v.is_finite() {
+            return Err(format!("history.csv column {name} would be {v}"));
+        }
+    }
+    for (i, c) in scene.history.columns.iter().enumerate() {
         let v = declared(scene, m, &c.measure)?;
-        values.push(c.scale * v);
+        let value = c.scale * v;
+        if !value.is_finite() {
+            return Err(format!(
+                "history.csv column {} would be {value}: history.columns[{i}].scale = {:e} times \
+                 {} = {v:e}; give a scale that keeps it finite",
+                c.name, c.scale, c.measure
+            ));
+        }
+        values.push(value);
     }
     Ok(values)
 }

@@ -28,12 +28,12 @@ fn main() {
         Ok(c) => c,
         Err(e) => {
             let e = RunError::Usage(e);
-            eprintln!("pfem-mpi: {e}\n{}", cli::USAGE);
+            eprintln!("pfem-mpi: {e}\n{}", cli::usage());
             std::process::exit(e.exit_code());
         }
     };
     match command {
-        Command::Help => println!("{}", cli::USAGE),
+        Command::Help => println!("{}", cli::usage()),
         Command::Version => println!("pfem-mpi {}", env!("CARGO_PKG_VERSION")),
         other => std::process::exit(commands::execute(other)),
     }
