@@ -190,7 +190,8 @@ impl Simulation {
                     raised: 0,
                 });
                 // Active when it touched at the end of the last increment, or when the body,
-                // where it will be, presses on the node where it is.
+                // where it will be, presses on the node where it is (suction does not reach
+                // across a gap).
                 let last = out.pairs.len() - 1;
                 let p = &mut out.pairs[last];
                 // A body that holds suction keeps what lies on it at the start of the
@@ -198,8 +199,7 @@ impl Simulation {
                 let on_body = p.suction > 0.0 && shape_from.closest(x).distance <= 0.01 * h;
                 p.active = touching
                     || on_body
-                    || p.multiplier - p.penalty * (shape.closest(x).distance - p.offset)
-                        > -p.suction;
+                    || p.multiplier - p.penalty * (shape.closest(x).distance - p.offset) > 0.0;
                 out.spacing.push(h);
             }
         }

@@ -43,7 +43,7 @@ pub struct Rigid {
     /// Uniform pressure the soil around the body is under (Pa, default 0): a surcharge on
     /// weightless clay, which changes no stress difference. The soil is modelled without it
     /// (its stresses are the excess over it) and the interface carries suction up to it before
-    /// it separates, as it would under the surcharge.
+    /// it separates, as it would under the surcharge. At most 1000 `material.young`.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub ambient_pressure: f64,
 }

@@ -89,3 +89,12 @@ fn contact_settings_out_of_their_working_range_are_refused() {
     }
     accepted(&["contact.penalty=1e7", "contact.tolerance=1e-9"]);
 }
+
+#[test]
+fn an_ambient_pressure_beyond_its_bound_is_refused() {
+    accepted(&["rigid[0].ambient_pressure=1e9"]);
+    for a in ["1e300", "1.1e9", "-1"] {
+        let (field, message) = refused(&[&format!("rigid[0].ambient_pressure={a}")]);
+        assert_eq!(field, "rigid[0].ambient_pressure", "{message}");
+    }
+}

@@ -122,6 +122,11 @@ fn check_lining(s: &Scene, i: usize, shape: &Shape) -> Result<(), Invalid> {
 const PENALTY: (f64, f64) = (1.0, 1e7);
 const TOLERANCE: (f64, f64) = (1e-9, 1e-2);
 
+/// Largest `ambient_pressure` as a multiple of `material.young`. Measured on the base pipe
+/// (E = 1 MPa): the force is the same from 1e5 to 1e12 Pa, and from 1e15 Pa a node held by
+/// suction away from the body takes more augmentations to let go than any step allows.
+const AMBIENT_PER_YOUNG: f64 = 1e3;
+
 fn check_contact(s: &Scene) -> Result<(), Invalid> {
     let c = FieldPath::key("contact");
     let penalty = s.contact.penalty;
@@ -180,10 +185,16 @@ pub fn check(s: &Scene) -> Result<(), Invalid> {
                 format!("must be in [0, 1] (got {})", r.adhesion),
             );
         }
-        if !(r.ambient_pressure >= 0.0 && r.ambient_pressure.is_finite()) {
+        let most = AMBIENT_PER_YOUNG * s.material.young;
+        if !(r.ambient_pressure >= 0.0 && r.ambient_pressure <= most) {
             return fail(
                 path.join("ambient_pressure"),
-                format!("must be >= 0 (got {})", r.ambient_pressure),
+                format!(
+                    "must be from 0 to {AMBIENT_PER_YOUNG} material.young = {most:e} Pa (got {:e}): \
+                     a soil under a larger pressure than that is no soil, and the interface \
+                     could not let go of the soil it holds",
+                    r.ambient_pressure
+                ),
             );
         }
         if r.adhesion > 0.0 && s.material.model != MaterialModel::Tresca {
