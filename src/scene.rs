@@ -70,6 +70,8 @@ mod validate;
 mod validate_fine;
 #[path = "scene/validate_loads.rs"]
 mod validate_loads;
+#[path = "scene/validate_motion.rs"]
+mod validate_motion;
 #[path = "scene/validate_rigid.rs"]
 pub mod validate_rigid;
 #[path = "scene/validate_supports.rs"]

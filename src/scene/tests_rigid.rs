@@ -98,3 +98,35 @@ fn an_ambient_pressure_beyond_its_bound_is_refused() {
         assert_eq!(field, "rigid[0].ambient_pressure", "{message}");
     }
 }
+
+/// Findings 1 and 3: a body that jumps through the soil in a step, or is thinner than the
+/// spacing, went through with zero force and exit 0.
+#[test]
+fn bodies_the_cloud_cannot_resolve_are_refused() {
+    let (field, message) = refused(&["rigid[0].stages=[{ to = [0.0, -1.0], steps = 1 }]"]);
+    assert_eq!(field, "rigid[0].stages[0].steps", "{message}");
+    assert!(message.contains("at least 50 steps"), "{message}");
+    let sideways = [
+        "rigid[0].circle={ centre = [0.3, 0.1], radius = 0.02 }",
+        "rigid[0].stages=[{ to = [1.0, 0.0], steps = 1 }]",
+    ];
+    assert_eq!(refused(&sideways).0, "rigid[0].stages[0].steps");
+    // Far above the soil a body may move fast.
+    accepted(&[
+        "rigid[0].circle={ centre = [0.3, 2.0], radius = 0.02 }",
+        "rigid[0].stages=[{ to = [0.0, 1.0], steps = 1 }]",
+    ]);
+    for thin in [
+        "rigid[0].circle={ centre = [0.3, 0.202], radius = 0.002 }",
+        "rigid[0].circle={ centre = [0.3, 0.2000001], radius = 1e-7 }",
+    ] {
+        let (field, message) = refused(&[thin]);
+        assert_eq!(field, "rigid[0].circle.radius", "{message}");
+        assert!(message.contains("thick"), "{message}");
+    }
+    let plate = "rigid=[{ name = \"pipe\", polygon = { vertices = [[0.299, 0.2], [0.301, 0.2], \
+                 [0.301, 0.3], [0.299, 0.3]] }, stages = [{ to = [0.0, -0.01], steps = 3 }] }]";
+    let (field, message) = refused(&[plate]);
+    assert_eq!(field, "rigid[0].polygon", "{message}");
+    accepted(&["rigid[0].circle={ centre = [0.3, 0.21], radius = 0.01 }"]);
+}

@@ -403,6 +403,7 @@ fn check_against_particles(s: &Scene) -> Result<(), Invalid> {
         check_selects_something(path, &p.region, &particles.position, tol)?;
     }
     super::validate_loads::check(s, &particles)?;
+    super::validate_motion::check(s, &particles)?;
     // The particle a point load goes to (`lattice::nearest`, ties to the smaller id).
     let nearest = |at: [f64; 2]| {
         let (gid, _) = lattice::nearest(&particles, at)?;
