@@ -97,8 +97,31 @@ pub(super) fn check_step(
             .is_some_and(|&g| holds_in_a_triangle(mesh, g));
         f64::from(u8::from(held))
     }));
+    // Per body: triangles that reached into it, and the size of the soil's force on it.
+    let n_loads = local.len();
+    let crossing = sim.crossing.borrow();
+    for (b, _) in sim.model.bodies.iter().enumerate() {
+        let f = sim.last_body_force.get(b).copied().unwrap_or([0.0; 2]);
+        local.push(crossing.get(b).copied().unwrap_or(0) as f64);
+        local.push(f[0].abs() + f[1].abs());
+    }
     let global = sum_f64(world, &local);
     let stop = "the run stops before writing this step";
+    for (b, pair) in global[n_loads..].chunks_exact(2).enumerate() {
+        if pair[0] > 0.0 && pair[1] == 0.0 {
+            return Err(RunError::Sanity {
+                step,
+                what: format!(
+                    "the rigid body \"{}\" lies in the soil ({} triangles of the mesh reached \
+                     into it) but no soil node touches it: the contact lost it (a body thinner \
+                     than the particle spacing, or one that moved through the soil in a step); \
+                     {stop}",
+                    sim.model.bodies[b].name, pair[0]
+                ),
+            });
+        }
+    }
+    let global = &global[..n_loads];
     if report.triangles == 0 {
         return Err(RunError::Sanity {
             step,
