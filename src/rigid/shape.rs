@@ -292,7 +292,7 @@ impl Shape {
                     curvature: 0.0,
                 };
             }
-            return self.from_edge(x, k, t, from_vertex);
+            return self.beyond_edge(x, k, t, from_vertex);
         }
         // Signed distances to the edge lines: their maximum is <= 0 exactly inside the core.
         let (mut s, mut k) = (f64::NEG_INFINITY, 0);
@@ -318,12 +318,18 @@ impl Shape {
                 (best, k, t) = (d, i, ti);
             }
         }
-        self.from_edge(x, k, t, from_vertex)
+        self.beyond_edge(x, k, t, from_vertex)
     }
 
     /// Proximity of a point outside the core whose nearest core point is at parameter `t` of
     /// edge `k`: a vertex at an end, else the edge.
-    fn from_edge(&self, x: P, k: usize, t: f64, from_vertex: impl Fn(P) -> Proximity) -> Proximity {
+    fn beyond_edge(
+        &self,
+        x: P,
+        k: usize,
+        t: f64,
+        from_vertex: impl Fn(P) -> Proximity,
+    ) -> Proximity {
         let n = self.core.len();
         if t == 0.0 {
             from_vertex(self.core[k])
