@@ -541,6 +541,17 @@ mod tests {
         (a - b).abs() <= tol
     }
 
+    /// Reproducible uniform numbers in [lo, hi) from `seed` (a linear congruential stream).
+    fn uniform(seed: u64) -> impl FnMut(f64, f64) -> f64 {
+        let mut state = seed;
+        move |lo, hi| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// Gradient of distance = normal and d(normal)/dx = curvature t tᵀ, by central differences.
     fn check_derivatives(s: &Shape, x: P) {
         let (h, p) = (1e-6, s.closest(x));
@@ -756,13 +767,7 @@ mod tests {
 
     #[test]
     fn triangle_depth_matches_sampling() {
-        let mut state = 12345u64;
-        let mut rnd = |lo: f64, hi: f64| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(12345);
         let n = 60;
         for shape in [
             Shape::circle([0.1, -0.2], 0.8).unwrap(),
@@ -817,13 +822,7 @@ mod tests {
             scan.tree = None;
             scan.deep = scan.find_deepest();
             assert!(close(fast.inradius(), scan.inradius(), 1e-12));
-            let mut state = 99u64;
-            let mut rnd = |lo: f64, hi: f64| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
-            };
+            let mut rnd = uniform(99);
             for _ in 0..2000 {
                 let x = [rnd(-1.0, 1.6), rnd(-0.8, 0.6)];
                 let (a, b) = (fast.closest(x), scan.closest(x));
