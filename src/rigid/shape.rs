@@ -515,6 +515,17 @@ impl Shape {
         pts
     }
 
+    /// Length of the shape's projection on the unit vector `n`: its width across `n`'s normal.
+    pub fn extent_along(&self, n: [f64; 2]) -> f64 {
+        let (lo, hi) = self
+            .core
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
+                (lo.min(dot(n, *c)), hi.max(dot(n, *c)))
+            });
+        hi - lo + 2.0 * self.radius
+    }
+
     /// Axis-aligned bounding box [[xmin, ymin], [xmax, ymax]].
     pub fn bounding_box(&self) -> [[f64; 2]; 2] {
         self.bbox

@@ -122,11 +122,15 @@ fn bodies_the_cloud_cannot_resolve_are_refused() {
     ] {
         let (field, message) = refused(&[thin]);
         assert_eq!(field, "rigid[0].circle.radius", "{message}");
-        assert!(message.contains("thick"), "{message}");
+        assert!(message.contains("wide across its motion"), "{message}");
     }
     let plate = "rigid=[{ name = \"pipe\", polygon = { vertices = [[0.299, 0.2], [0.301, 0.2], \
                  [0.301, 0.3], [0.299, 0.3]] }, stages = [{ to = [0.0, -0.01], steps = 3 }] }]";
     let (field, message) = refused(&[plate]);
     assert_eq!(field, "rigid[0].polygon", "{message}");
+    // The same plate lying flat, pressed down, spans many particles.
+    let flat = "rigid=[{ name = \"pipe\", polygon = { vertices = [[0.2, 0.2], [0.4, 0.2], \
+                [0.4, 0.202], [0.2, 0.202]] }, stages = [{ to = [0.0, -0.01], steps = 3 }] }]";
+    accepted(&[flat]);
     accepted(&["rigid[0].circle={ centre = [0.3, 0.21], radius = 0.01 }"]);
 }

@@ -1,8 +1,8 @@
-//! Rigid bodies the particle cloud can resolve: at least one spacing thick where the soil
-//! meets them, and moving at most one spacing a step while they sweep through the soil. A
-//! thinner body passed between the particles with no force (a pipe of radius h/10 pushed
-//! 0.03 m in: fy = 0), and one that jumped a metre in a step went through the soil untouched;
-//! both ended with exit 0.
+//! Rigid bodies the particle cloud can resolve: at least one spacing wide across their motion
+//! where they meet the soil, and moving at most one spacing a step while they sweep through
+//! it. A narrower body passed between the particles with no force (a pipe of radius h/10
+//! pushed 0.03 m in: fy = 0), and one that jumped a metre in a step went through the soil
+//! untouched; both ended with exit 0.
 
 use super::field_path::FieldPath;
 use super::schema::Scene;
@@ -66,8 +66,8 @@ fn spacing_in(s: &Scene, particles: &ParticleSet, b: Box2) -> f64 {
         .unwrap_or(s.mesh.h)
 }
 
-/// Every body's thickness against the spacing where it meets the soil, and every stage's
-/// motion per step against the spacing of the soil it sweeps.
+/// Every stage's width across its motion and its motion per step against the spacing of the
+/// soil the body sweeps.
 pub(super) fn check(s: &Scene, particles: &ParticleSet) -> Result<(), Invalid> {
     for (i, r) in s.rigid.iter().enumerate() {
         let Ok(shape) = super::validate_rigid::shape_of(s, i) else {
@@ -83,10 +83,31 @@ pub(super) fn check(s: &Scene, particles: &ParticleSet) -> Result<(), Invalid> {
         }
         // One particle pass per body: the coarsest spacing anywhere along its path.
         let h = spacing_in(s, particles, grown(path_box, s.mesh.h));
+        let what = if r.circle.is_some() {
+            path.join("circle").join("radius")
+        } else {
+            path.join("polygon")
+        };
         let mut from = origin;
         for (k, st) in r.stages.iter().enumerate() {
             let b = swept(&shape, from, st.to);
-            let step = (st.to[0] - from[0]).hypot(st.to[1] - from[1]) / st.steps as f64;
+            let d = [st.to[0] - from[0], st.to[1] - from[1]];
+            let length = d[0].hypot(d[1]);
+            // Across its motion the body must span a spacing, or it passes between particles
+            // (a flat platen pressed down spans many; a plate pushed edge-first, none).
+            let width = shape.extent_along([-d[1] / length, d[0] / length]);
+            if length > 0.0 && width < h * (1.0 - 1e-9) && near_soil(s, b, h) {
+                return fail(
+                    what,
+                    format!(
+                        "the body is {width:.3e} m wide across its motion in stage {k}, less \
+                         than the particle spacing {h} of the soil it meets: it would pass \
+                         between the particles; make it at least {h} m wide or refine the soil \
+                         there to a spacing of at most {width:.3e} m ([[mesh.fine]])"
+                    ),
+                );
+            }
+            let step = length / st.steps as f64;
             if step > h * (1.0 + 1e-9) && near_soil(s, b, h) {
                 let needed = ((st.steps as f64) * step / h).ceil();
                 return fail(
@@ -100,23 +121,6 @@ pub(super) fn check(s: &Scene, particles: &ParticleSet) -> Result<(), Invalid> {
                 );
             }
             from = st.to;
-        }
-        let thickness = 2.0 * shape.inradius();
-        if thickness < h * (1.0 - 1e-9) {
-            let what = if r.circle.is_some() {
-                path.join("circle").join("radius")
-            } else {
-                path.join("polygon")
-            };
-            return fail(
-                what,
-                format!(
-                    "the body is {thickness:.3e} m thick where it is thinnest, less than the \
-                     particle spacing {h} of the soil it meets: it would pass between the \
-                     particles; make it at least {h} m thick or refine the soil there to a \
-                     spacing of at most {thickness:.3e} m ([[mesh.fine]])"
-                ),
-            );
         }
     }
     Ok(())
