@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-pub const USAGE: &str = "\
+const USAGE: &str = "\
 usage:
   pfem-mpi new <NAME|scene.toml> -o case.h5 [--set key=value ...]   write a case file
   pfem-mpi info FILE.h5                                             summarise a case or checkpoint
@@ -10,7 +10,12 @@ usage:
   pfem-mpi plot DIR                                                 draw DIR/plots/*.png from a run's output
   mpirun -n N pfem-mpi FILE.h5 [--out DIR] [--until-step K] [-- PETSc options]
                                                                     run (or continue) an analysis
-built-in scenes: cantilever, footing-shallow, block-compression";
+built-in scenes:";
+
+/// The usage text, ending with every built-in scene's name.
+pub fn usage() -> String {
+    format!("{USAGE} {}", crate::scene::builtin_names())
+}
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
@@ -143,6 +148,13 @@ mod tests {
 
     fn args(s: &str) -> Vec<String> {
         s.split_whitespace().map(String::from).collect()
+    }
+
+    #[test]
+    fn usage_lists_every_built_in_scene() {
+        for (name, _) in crate::scene::BUILTINS {
+            assert!(usage().contains(name), "{name} missing from the usage text");
+        }
     }
 
     #[test]

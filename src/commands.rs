@@ -91,6 +91,17 @@ fn new(world: &Comm, scene: &str, out: &std::path::Path, sets: &[String]) -> Res
             header_particles(&set),
             scene_v.name
         );
+        // Probes follow the point loads in `tracked_gids`.
+        let probes = header.tracked_gids.iter().skip(scene_v.point_load.len());
+        for (probe, gid) in scene_v.probe.iter().zip(probes) {
+            if let Some(i) = set.gid.iter().position(|g| g == gid) {
+                let x = set.position[i];
+                println!(
+                    "probe {} follows particle {gid} at [{}, {}]",
+                    probe.name, x[0], x[1]
+                );
+            }
+        }
     }
     Ok(())
 }

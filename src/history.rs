@@ -54,9 +54,20 @@ pub fn row(scene: &Scene, m: &Measures) -> Result<Vec<f64>, String> {
         Some(kind) => kind_row(scene, kind, m)?,
         None => Vec::new(),
     };
-    for c in &scene.history.columns {
+    // A declared value that is not a number is a result no one can use: the run stops on it.
+    // (The legacy kinds' columns stay as they were: `block`'s stress over cu is infinite for
+    // an elastic block, cu = 0, by its definition.)
+    for (i, c) in scene.history.columns.iter().enumerate() {
         let v = declared(scene, m, &c.measure)?;
-        values.push(c.scale * v);
+        let value = c.scale * v;
+        if !value.is_finite() {
+            return Err(format!(
+                "history.csv column {} would be {value}: history.columns[{i}].scale = {:e} times \
+                 {} = {v:e}; give a scale that keeps it finite",
+                c.name, c.scale, c.measure
+            ));
+        }
+        values.push(value);
     }
     Ok(values)
 }

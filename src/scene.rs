@@ -1,7 +1,7 @@
 //! Scenes: the problem description a user runs, as a TOML document (SI units).
 //!
-//! A scene is either a built-in (`cantilever`, `footing-shallow`, `block-compression`) or a
-//! `.toml` file. `--set a.b.c=value` overrides are applied to the TOML tree before it is read,
+//! A scene is either a built-in (`cantilever`, `footing`, ...: [`BUILTINS`]) or a `.toml`
+//! file. `--set a.b.c=value` overrides are applied to the TOML tree before it is read,
 //! and every table rejects unknown keys, so typos are errors that name the key. Layout:
 //!
 //! ```toml
@@ -68,6 +68,10 @@ pub mod selector;
 mod validate;
 #[path = "scene/validate_fine.rs"]
 mod validate_fine;
+#[path = "scene/validate_loads.rs"]
+mod validate_loads;
+#[path = "scene/validate_motion.rs"]
+mod validate_motion;
 #[path = "scene/validate_rigid.rs"]
 pub mod validate_rigid;
 #[path = "scene/validate_supports.rs"]
@@ -159,14 +163,14 @@ impl Scene {
             }
         })?;
 
-        if scene.steps.count == 0 {
-            scene.steps.count = validate_rigid::stage_total(&scene).min(u32::MAX as u64) as u32;
-        }
-        validate::validate(&scene).map_err(|(path, message)| SceneError {
+        let invalid = |(path, message): validate::Invalid| SceneError {
             set: responsible_set(&parsed, &path).map(|s| s.raw.clone()),
             field: Some(path.to_string()),
             ..SceneError::new(source, message)
-        })?;
+        };
+        scene.steps.count =
+            validate_rigid::check_stages(&scene, scene.steps.count != 0).map_err(invalid)?;
+        validate::validate(&scene).map_err(invalid)?;
         Ok(scene)
     }
 
@@ -235,3 +239,7 @@ pub fn load_scene(name_or_path: &str, sets: &[String]) -> Result<(Scene, String)
 #[cfg(test)]
 #[path = "scene/tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "scene/tests_rigid.rs"]
+mod tests_rigid;

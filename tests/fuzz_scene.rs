@@ -5,6 +5,9 @@
 //! through the scene parser, validation, model construction and, where its lattice is small,
 //! particle generation: in-process, each case within a time limit, with no panic.
 
+mod common;
+
+use common::Rng;
 use pfem_mpi::case_file::new_case;
 use pfem_mpi::model::Model;
 use pfem_mpi::scene::{Scene, BUILTINS};
@@ -18,24 +21,6 @@ const CASES: usize = 1200;
 const LIMIT: Duration = Duration::from_secs(10);
 /// Largest lattice generated in the test (validation itself allows 5e7).
 const MAX_TEST_PARTICLES: f64 = 1e5;
-
-/// xorshift64*: deterministic, so a failure names a case that reproduces.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-    fn pick<'a, T>(&mut self, v: &'a [T]) -> &'a T {
-        &v[self.below(v.len())]
-    }
-}
 
 fn weird_value(rng: &mut Rng) -> Value {
     match rng.below(16) {

@@ -96,7 +96,7 @@ pub struct PairForce {
     /// d force / d u, row-major.
     pub tangent: [[f64; 2]; 2],
     /// Normal pressure (Pa); for an inactive node the pressure it would have if it touched
-    /// (the next active set takes it in when that exceeds −suction).
+    /// (the next active set takes it in when that is positive).
     pub pressure: f64,
     /// Shear stress along t (Pa).
     pub shear: f64,

@@ -4,6 +4,7 @@
 
 pub mod body;
 pub mod contact;
+pub mod edge_tree;
 pub mod shape;
 
 pub use body::RigidBody;

@@ -16,6 +16,8 @@ pub(super) struct BoundaryLoads {
     pub spacing: Vec<f64>,
     pub bodies: Vec<Shape>,
     pub surface: Vec<([u32; 3], f64)>,
+    /// Boundary edges each `[[surface_pressure]]` entry selects on this rank.
+    pub surface_edges: Vec<usize>,
 }
 
 /// Contact state kept per node between increments: (node key, body) → (pressure, shear).
@@ -39,6 +41,7 @@ impl Simulation {
             spacing: Vec::new(),
             bodies,
             surface: Vec::new(),
+            surface_edges: vec![0; model.scene.surface_pressure.len()],
         };
         if model.bodies.is_empty() && model.scene.surface_pressure.is_empty() {
             return out;
@@ -70,13 +73,14 @@ impl Simulation {
                 len,
                 mesh.h[a as usize].max(mesh.h[b as usize]),
             ));
-            for sp in &model.scene.surface_pressure {
+            for (k, sp) in model.scene.surface_pressure.iter().enumerate() {
                 let inside = |p: u32| {
                     sp.region
                         .matches(self.reference_position(mesh, p as usize), model.tol)
                 };
                 if inside(a) && inside(b) {
                     out.surface.push(([na, m, nb], sp.pressure));
+                    out.surface_edges[k] += 1;
                 }
             }
         }
@@ -185,7 +189,8 @@ impl Simulation {
                     raised: 0,
                 });
                 // Active when it touched at the end of the last increment, or when the body,
-                // where it will be, presses on the node where it is.
+                // where it will be, presses on the node where it is (suction does not reach
+                // across a gap).
                 let last = out.pairs.len() - 1;
                 let p = &mut out.pairs[last];
                 // A body that holds suction keeps what lies on it at the start of the
@@ -193,12 +198,37 @@ impl Simulation {
                 let on_body = p.suction > 0.0 && shape_from.closest(x).distance <= 0.01 * h;
                 p.active = touching
                     || on_body
-                    || p.multiplier - p.penalty * (shape.closest(x).distance - p.offset)
-                        > -p.suction;
+                    || p.multiplier - p.penalty * (shape.closest(x).distance - p.offset) > 0.0;
                 out.spacing.push(h);
             }
         }
         out
+    }
+}
+
+impl Simulation {
+    /// Collective. A `[[surface_pressure]]` whose `where` selects no boundary edge on any rank
+    /// is an error: its pressure would silently act on nothing (`edges`: this rank's counts).
+    pub(super) fn check_surface_selection(
+        &self,
+        world: &pfem_partition::Comm,
+        edges: &[usize],
+        step: u64,
+    ) -> Result<(), super::step::SolveError> {
+        if edges.is_empty() {
+            return Ok(());
+        }
+        let counts: Vec<f64> = edges.iter().map(|&n| n as f64).collect();
+        let counts = pfem_partition::sum_f64(world, &counts);
+        match counts.iter().position(|&n| n == 0.0) {
+            Some(k) => Err(super::step::SolveError::Fatal(format!(
+                "step {step}: surface_pressure[{k}].where = \"{}\" selects no boundary edge of \
+                 the body (edges whose two ends started in it): its pressure would act on \
+                 nothing",
+                self.model.scene.surface_pressure[k].region
+            ))),
+            None => Ok(()),
+        }
     }
 }
 

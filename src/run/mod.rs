@@ -17,6 +17,7 @@ mod step;
 mod test_hooks;
 
 pub use error::{RunError, EXIT_FAILURE, EXIT_USAGE};
+pub use signals::install_stop_handlers;
 pub use simulation::{Simulation, StepReport};
 
 use crate::petsc::Petsc;

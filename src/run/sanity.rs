@@ -139,8 +139,31 @@ pub(super) fn check_step(
             .is_some_and(|&g| holds_in_a_triangle(mesh, g));
         f64::from(u8::from(held))
     }));
+    // Per body: triangles that reached into it, and the size of the soil's force on it.
+    let n_loads = local.len();
+    let crossing = sim.crossing.borrow();
+    for (b, _) in sim.model.bodies.iter().enumerate() {
+        let f = sim.last_body_force.get(b).copied().unwrap_or([0.0; 2]);
+        local.push(crossing.get(b).copied().unwrap_or(0) as f64);
+        local.push(f[0].abs() + f[1].abs());
+    }
     let global = sum_f64(world, &local);
     let stop = "the run stops before writing this step";
+    for (b, pair) in global[n_loads..].chunks_exact(2).enumerate() {
+        if pair[0] > 0.0 && pair[1] == 0.0 {
+            return Err(RunError::Sanity {
+                step,
+                what: format!(
+                    "the rigid body \"{}\" lies in the soil ({} triangles of the mesh reached \
+                     into it) but no soil node touches it: the contact lost it (a body thinner \
+                     than the particle spacing, or one that moved through the soil in a step); \
+                     {stop}",
+                    sim.model.bodies[b].name, pair[0]
+                ),
+            });
+        }
+    }
+    let global = &global[..n_loads];
     if report.triangles == 0 {
         return Err(RunError::Sanity {
             step,
@@ -214,8 +237,18 @@ fn load_strain(scene: &Scene) -> f64 {
 
 /// What to tell the user when Newton could not get through a step even in the smallest piece:
 /// what in the scene makes the system ill-posed when something does, else the usual remedies.
-pub(super) fn divergence_advice(model: &crate::model::Model) -> String {
+/// `contact`: what failed was the contact pressures settling, not Newton.
+pub(super) fn divergence_advice(model: &crate::model::Model, contact: bool) -> String {
     let scene = &model.scene;
+    if contact {
+        let c = &scene.contact;
+        return format!(
+            "the contact pressures did not settle: allow more solves (contact.max_augmentations \
+             = {}, default 12), loosen contact.tolerance (= {:e}, default 1e-6), or bring \
+             contact.penalty (= {:e}, default 1000) nearer its default",
+            c.max_augmentations, c.tolerance, c.penalty
+        );
+    }
     let nu = scene.material.poisson;
     if !model.mixed() && nu >= LOCKING_POISSON {
         return format!(
@@ -258,12 +291,17 @@ mod tests {
             let (scene, _) = crate::scene::load_scene("cantilever", &sets).unwrap();
             crate::model::Model::new(&scene).unwrap()
         };
-        assert!(divergence_advice(&model(&[])).contains("a smaller step"));
-        let locked = divergence_advice(&model(&["material.poisson=0.49999999"]));
+        assert!(divergence_advice(&model(&[]), false).contains("a smaller step"));
+        let locked = divergence_advice(&model(&["material.poisson=0.49999999"]), false);
         assert!(locked.contains("solver.element = \"p2p1\""), "{locked}");
         let mixed = model(&["material.poisson=0.49999999", "solver.element=\"p2p1\""]);
-        assert!(divergence_advice(&mixed).contains("a smaller step"));
-        let soft = divergence_advice(&model(&["material.young=1e-300"]));
+        assert!(divergence_advice(&mixed, false).contains("a smaller step"));
+        let soft = divergence_advice(&model(&["material.young=1e-300"]), false);
         assert!(soft.contains("material.young = 1e-300 Pa"), "{soft}");
+        let contact = divergence_advice(&model(&[]), true);
+        assert!(
+            contact.contains("contact.max_augmentations = 12"),
+            "{contact}"
+        );
     }
 }

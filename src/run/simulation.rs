@@ -29,6 +29,9 @@ pub struct Simulation {
     /// entry, and of the soil's force on each rigid body.
     pub(super) last_set_reactions: Vec<[f64; 2]>,
     pub(super) last_body_force: Vec<[f64; 2]>,
+    /// This rank's triangles the last remesh dropped for reaching into each rigid body: a body
+    /// that has some lies in the soil.
+    pub(super) crossing: std::cell::RefCell<Vec<usize>>,
     /// Contact pressure and shear per contact node of the last increment.
     pub(super) last_contact: std::cell::RefCell<super::contact::ContactState>,
     /// Contact augmentations (Newton solves after the first) since the last step report.
@@ -111,6 +114,7 @@ impl Simulation {
             last_area: 0.0,
             last_set_reactions: Vec::new(),
             last_body_force: Vec::new(),
+            crossing: Default::default(),
             last_contact: Default::default(),
             augmentations: Default::default(),
             contact_seconds: Default::default(),
@@ -210,9 +214,15 @@ impl Simulation {
         }
         let lambda = self.header.load_factor;
         let shapes: Vec<_> = self.model.bodies.iter().map(|b| b.shape(lambda)).collect();
+        let crossing = std::cell::RefCell::new(vec![0; shapes.len()]);
         mesh.drop_triangles(rank, |p, h| {
-            shapes.iter().any(|s| crate::rigid::crosses(s, p, h))
+            let hit = shapes.iter().position(|s| crate::rigid::crosses(s, p, h));
+            if let Some(b) = hit {
+                crossing.borrow_mut()[b] += 1;
+            }
+            hit.is_some()
         });
+        *self.crossing.borrow_mut() = crossing.into_inner();
     }
 
     /// Start-of-step Gauss states on the new mesh (rank-local). The old mesh's states are

@@ -111,13 +111,18 @@ fn pattern_signature(dofs: &DofMap) -> u64 {
 pub enum SolveError {
     /// Newton did not converge: a smaller increment may.
     Diverged(String),
+    /// The contact pressures did not settle within `contact.max_augmentations` solves: a
+    /// smaller increment may settle them.
+    ContactUnsettled(String),
     Fatal(String),
 }
 
 impl std::fmt::Display for SolveError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            SolveError::Diverged(m) | SolveError::Fatal(m) => f.write_str(m),
+            SolveError::Diverged(m) | SolveError::ContactUnsettled(m) | SolveError::Fatal(m) => {
+                f.write_str(m)
+            }
         }
     }
 }
@@ -289,6 +294,7 @@ impl Simulation {
         let clock = std::time::Instant::now();
         let loads = self.boundary_loads(mesh, &dofs, from, to);
         self.add_contact_time(clock);
+        self.check_surface_selection(world, &loads.surface_edges, step)?;
         let spacing = loads.spacing;
         let setup = StepSetup {
             laws: self.model.laws(to),
@@ -653,7 +659,7 @@ impl Simulation {
                     break;
                 }
                 if augmentations + 1 >= contact.max_augmentations as usize {
-                    return Err(SolveError::Diverged(format!(
+                    return Err(SolveError::ContactUnsettled(format!(
                         "step {step}: contact did not settle in {} Newton solves ({switched} \
                          nodes still changing contact, pressures by {:.1e} relative)",
                         contact.max_augmentations,
@@ -808,6 +814,8 @@ impl Simulation {
         } else {
             self.header.load_factor += solved.dlambda;
         }
+        // The analysis is quasi-static: its time is the load factor, as the XDMF frames' is.
+        self.header.time = self.header.load_factor;
         Ok(StepReport {
             newton_iterations: solved.newton_iterations,
             linear_iterations: solved.linear_iterations,
@@ -928,26 +936,33 @@ impl Simulation {
                     *mesh = self.remesh(world)?;
                     states = self.map(mesh);
                 }
-                Err(SolveError::Diverged(_)) if !self.alternate_search.get() => {
+                Err(SolveError::Diverged(_) | SolveError::ContactUnsettled(_))
+                    if !self.alternate_search.get() =>
+                {
                     self.alternate_search.set(true);
                 }
-                Err(SolveError::Diverged(_)) if may_cut(cuts, piece) => {
+                Err(SolveError::Diverged(_) | SolveError::ContactUnsettled(_))
+                    if may_cut(cuts, piece) =>
+                {
                     self.alternate_search.set(false);
                     cuts += 1;
                     piece *= 0.5;
                 }
-                Err(SolveError::Diverged(_)) if steps.until_collapse => {
+                Err(SolveError::Diverged(_) | SolveError::ContactUnsettled(_))
+                    if steps.until_collapse =>
+                {
                     let counts = [newton, linear, cuts, remapped as usize];
                     return Ok(self.collapsed(world, mesh, converged_pieces, [from, to], counts));
                 }
-                Err(SolveError::Diverged(message)) => {
+                Err(e @ (SolveError::Diverged(_) | SolveError::ContactUnsettled(_))) => {
+                    let contact = matches!(e, SolveError::ContactUnsettled(_));
                     return Err(super::RunError::Diverged {
-                        message,
+                        message: e.to_string(),
                         piece: (full / (to - from)).round(),
                         cuts,
                         from,
-                        advice: super::sanity::divergence_advice(&self.model),
-                    })
+                        advice: super::sanity::divergence_advice(&self.model, contact),
+                    });
                 }
                 Err(e) => return Err(super::RunError::Solve(e)),
             }

@@ -43,7 +43,7 @@ pub struct Rigid {
     /// Uniform pressure the soil around the body is under (Pa, default 0): a surcharge on
     /// weightless clay, which changes no stress difference. The soil is modelled without it
     /// (its stresses are the excess over it) and the interface carries suction up to it before
-    /// it separates, as it would under the surcharge.
+    /// it separates, as it would under the surcharge. At most 1000 `material.young`.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub ambient_pressure: f64,
 }
@@ -83,13 +83,13 @@ pub struct Stage {
 #[serde(deny_unknown_fields, default)]
 pub struct Contact {
     /// Normal and tangential penalty stiffness as a multiple of E/h (h the spacing at the
-    /// node). Default 1000.
+    /// node), 1 to 1e7. Default 1000.
     pub penalty: f64,
     /// Augmentations end when no contact node's penetration exceeds this fraction of its
     /// spacing and the contact pressures changed by less than `tolerance` relative in the last
-    /// augmentation. Default 1e-6.
+    /// augmentation, 1e-9 to 0.01. Default 1e-6.
     pub tolerance: f64,
-    /// Most Newton solves per increment (the first plus augmentations). Default 12.
+    /// Most Newton solves per increment (the first plus augmentations), >= 2. Default 12.
     pub max_augmentations: u32,
     /// Start every increment from the contact pressures and shears of the last one, carried
     /// across the remesh by node identity, and a node new to the contact from the soil's

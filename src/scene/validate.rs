@@ -488,21 +488,8 @@ fn check_against_particles(s: &Scene) -> Result<(), Invalid> {
         }
         check_selects_something(entry, (&p.region, p.on.as_deref()), &boundaries, s, x)?;
     }
-    for (i, p) in s.point_load.iter().enumerate() {
-        if let Some((_, dist)) = lattice::nearest(&particles, p.at) {
-            if dist > s.mesh.h * (1.0 + 1e-9) {
-                return fail(
-                    FieldPath::key("point_load").at(i).join("at"),
-                    format!(
-                        "{} is {dist:.4} m from the nearest particle; it must lie within one \
-                         particle spacing ({}) of the body",
-                        vec2(p.at),
-                        s.mesh.h
-                    ),
-                );
-            }
-        }
-    }
+    super::validate_loads::check(s, &particles)?;
+    super::validate_motion::check(s, &particles)?;
     // The particle a point load goes to (`lattice::nearest`, ties to the smaller id).
     let nearest = |at: [f64; 2]| {
         let (gid, _) = lattice::nearest(&particles, at)?;

@@ -12,17 +12,50 @@ fn fail<T>(path: FieldPath, message: String) -> Result<T, Invalid> {
     Err((path, message))
 }
 
-fn finite_positive(path: FieldPath, x: f64) -> Result<(), Invalid> {
-    if x > 0.0 && x.is_finite() {
-        Ok(())
-    } else {
-        fail(path, format!("must be > 0 (got {x})"))
-    }
-}
-
 /// The longest stage total of the rigid bodies (0 without stages).
 pub fn stage_total(s: &Scene) -> u64 {
     s.rigid.iter().map(|r| r.stage_steps()).max().unwrap_or(0)
+}
+
+/// The stages of every body, checked before the step count is taken from them: each stage
+/// moves somewhere finite in at least one step, their total fits the step counter, and a scene
+/// that leaves `steps.count` out has a stage to take it from. `count_given`: `steps.count` was
+/// in the scene (0 means left out). Returns the step count the scene runs.
+pub fn check_stages(s: &Scene, count_given: bool) -> Result<u32, Invalid> {
+    for (i, r) in s.rigid.iter().enumerate() {
+        let path = FieldPath::key("rigid").at(i).join("stages");
+        for (k, st) in r.stages.iter().enumerate() {
+            let sp = path.at(k);
+            if !st.to.iter().all(|x| x.is_finite()) {
+                return fail(sp.join("to"), format!("must be finite (got {:?})", st.to));
+            }
+            if st.steps < 1 {
+                return fail(sp.join("steps"), "must be >= 1 (got 0)".to_string());
+            }
+        }
+        if r.stage_steps() > u32::MAX as u64 {
+            return fail(
+                path,
+                format!(
+                    "take {} steps together, more than the largest step count {}",
+                    r.stage_steps(),
+                    u32::MAX
+                ),
+            );
+        }
+    }
+    if count_given {
+        return Ok(s.steps.count);
+    }
+    match s.rigid.iter().position(|r| r.stages.is_empty()) {
+        Some(i) if stage_total(s) == 0 => fail(
+            FieldPath::key("rigid").at(i).join("stages"),
+            "is empty and steps.count is left out: give the body a stage, e.g. `stages = [{ to \
+             = [0.0, -0.01], steps = 10 }]`, or set steps.count"
+                .to_string(),
+        ),
+        _ => Ok(stage_total(s) as u32),
+    }
 }
 
 /// The shape of `[[rigid]]` entry `i` at its initial position.
@@ -73,11 +106,63 @@ fn check_lining(s: &Scene, i: usize, shape: &Shape) -> Result<(), Invalid> {
     fail(
         path,
         format!(
-            "the body's perimeter ({perimeter:.3e} m) would take {points:.3e} lining particles at              the spacing {finest}, more than the limit of {} ({})",
+            "the body's perimeter ({perimeter:.3e} m) would take {points:.3e} lining particles at \
+             the spacing {finest}, more than the limit of {} ({})",
             super::validate::MAX_PARTICLES,
             super::validate::LIMIT_REASON
         ),
     )
+}
+
+/// Bounds of `[contact]`, measured on issue 32's pipe (tests/scenes/pipe-on-ground.toml, 2
+/// ranks): every penalty from 0.1 to 1e7 gave fy = 4 055.05 N/m, 1e8 gave 4 030 (fx of the
+/// wrong sign) and 0.1 took 72 s against the default's 4 s; a tolerance of 1e-9 settled, 1e-12 did
+/// not (the pressures stalled at 2.5e-9 relative), 0.01 gave 4 055.7 and 0.5 gave 5 730; one
+/// solve can never confirm a pressure.
+const PENALTY: (f64, f64) = (1.0, 1e7);
+const TOLERANCE: (f64, f64) = (1e-9, 1e-2);
+
+/// Largest `ambient_pressure` as a multiple of `material.young`. Measured on the base pipe
+/// (E = 1 MPa): the force is the same from 1e5 to 1e12 Pa, and from 1e15 Pa a node held by
+/// suction away from the body takes more augmentations to let go than any step allows.
+const AMBIENT_PER_YOUNG: f64 = 1e3;
+
+fn check_contact(s: &Scene) -> Result<(), Invalid> {
+    let c = FieldPath::key("contact");
+    let penalty = s.contact.penalty;
+    if !(PENALTY.0..=PENALTY.1).contains(&penalty) {
+        return fail(
+            c.join("penalty"),
+            format!(
+                "must be from {:e} to {:e} (got {penalty:e}; default 1000): softer, the pressures \
+                 take many more solves to settle; stiffer, the tangent is too ill-conditioned \
+                 for an accurate force",
+                PENALTY.0, PENALTY.1
+            ),
+        );
+    }
+    let tolerance = s.contact.tolerance;
+    if !(TOLERANCE.0..=TOLERANCE.1).contains(&tolerance) {
+        return fail(
+            c.join("tolerance"),
+            format!(
+                "must be from {:e} to {} (got {tolerance:e}; default 1e-6): below, round-off \
+                 keeps the pressures from settling; above, the force is off (by 41 % at 0.5)",
+                TOLERANCE.0, TOLERANCE.1
+            ),
+        );
+    }
+    if s.contact.max_augmentations < 2 {
+        return fail(
+            c.join("max_augmentations"),
+            format!(
+                "must be >= 2 (got {}; default 12): the first solve's pressures are settled only \
+                 when a second confirms them",
+                s.contact.max_augmentations
+            ),
+        );
+    }
+    Ok(())
 }
 
 pub fn check(s: &Scene) -> Result<(), Invalid> {
@@ -94,25 +179,22 @@ pub fn check(s: &Scene) -> Result<(), Invalid> {
             return fail(path.join("name"), format!("\"{}\" is used twice", r.name));
         }
         check_lining(s, i, &shape_of(s, i)?)?;
-        for (k, st) in r.stages.iter().enumerate() {
-            let sp = path.join("stages").at(k);
-            if !st.to.iter().all(|x| x.is_finite()) {
-                return fail(sp.join("to"), format!("must be finite (got {:?})", st.to));
-            }
-            if st.steps < 1 {
-                return fail(sp.join("steps"), "must be >= 1 (got 0)".to_string());
-            }
-        }
         if !(0.0..=1.0).contains(&r.adhesion) {
             return fail(
                 path.join("adhesion"),
                 format!("must be in [0, 1] (got {})", r.adhesion),
             );
         }
-        if !(r.ambient_pressure >= 0.0 && r.ambient_pressure.is_finite()) {
+        let most = AMBIENT_PER_YOUNG * s.material.young;
+        if !(r.ambient_pressure >= 0.0 && r.ambient_pressure <= most) {
             return fail(
                 path.join("ambient_pressure"),
-                format!("must be >= 0 (got {})", r.ambient_pressure),
+                format!(
+                    "must be from 0 to {AMBIENT_PER_YOUNG} material.young = {most:e} Pa (got {:e}): \
+                     a soil under a larger pressure than that is no soil, and the interface \
+                     could not let go of the soil it holds",
+                    r.ambient_pressure
+                ),
             );
         }
         if r.adhesion > 0.0 && s.material.model != MaterialModel::Tresca {
@@ -124,20 +206,7 @@ pub fn check(s: &Scene) -> Result<(), Invalid> {
             );
         }
     }
-    let c = FieldPath::key("contact");
-    finite_positive(c.join("penalty"), s.contact.penalty)?;
-    if !(s.contact.tolerance > 0.0 && s.contact.tolerance < 1.0) {
-        return fail(
-            c.join("tolerance"),
-            format!("must be > 0 and < 1 (got {})", s.contact.tolerance),
-        );
-    }
-    if s.contact.max_augmentations < 1 {
-        return fail(
-            c.join("max_augmentations"),
-            "must be >= 1 (got 0)".to_string(),
-        );
-    }
+    check_contact(s)?;
     for (i, p) in s.surface_pressure.iter().enumerate() {
         if !p.pressure.is_finite() {
             return fail(

@@ -578,7 +578,10 @@ impl<'a> StepProblem<'a> {
     }
 
     /// Updates the active set and the augmented multipliers from the solution `local`:
-    /// λ ← max(−suction, λ − ε g), active where that exceeds −suction. `spacing` is each pair's node
+    /// λ ← max(−suction, λ − ε g); a node in the set stays while that exceeds −suction, one
+    /// outside enters when it is positive. Suction holds soil that touches the body: letting it
+    /// take nodes in across a gap made an ambient pressure of 1e300 pull in every node near the
+    /// body (fx = −15 854 N where 0 and 1e5 give 26). `spacing` is each pair's node
     /// spacing, to report the penetration relative to it.
     /// With `switch` false the active set is kept (only the multipliers change): the last
     /// resort when nodes keep entering and leaving it.
@@ -598,9 +601,12 @@ impl<'a> StepProblem<'a> {
             let change = (p - c.multiplier).abs();
             a.change = a.change.max(change);
             c.stiffen_if_stalled(change, settled);
-            a.pressure = a.pressure.max(p + c.suction);
+            // The scale of the pressures, not their distance from the suction floor (which
+            // an ambient pressure of 1e300 made the scale, so that anything settled).
+            a.pressure = a.pressure.max(p.abs());
             a.penetration = a.penetration.max(-f.gap / h);
-            let active = f.pressure > -c.suction;
+            let floor = if c.active { -c.suction } else { 0.0 };
+            let active = f.pressure > floor;
             if switch && active != c.active {
                 a.switched += 1;
                 c.active = active;

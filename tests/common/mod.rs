@@ -3,8 +3,11 @@
 #![allow(dead_code)]
 
 mod launch;
+mod rng;
 #[allow(unused_imports)]
 pub use launch::{example_binary, mpirun_example, run_captured};
+#[allow(unused_imports)]
+pub use rng::Rng;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
