@@ -68,6 +68,8 @@ fn global_particles(n: usize) -> ParticleSet {
         let row: [f64; STATE_LEN] = std::array::from_fn(|k| value(10 * i + 5 + 1000 * k as u64));
         p.state.push(&row);
         p.flags.push((i as u32).wrapping_mul(0x9e37_79b9));
+        // The cantilever has one material.
+        p.material.push(0);
     }
     p
 }
@@ -93,6 +95,7 @@ fn same_bits(a: &ParticleSet, b: &ParticleSet) -> bool {
             .zip(b.state.iter())
             .all(|(x, y)| (0..STATE_LEN).all(|k| x[k].to_bits() == y[k].to_bits()))
         && a.flags == b.flags
+        && a.material == b.material
 }
 
 fn same_header(a: &CaseHeader, b: &CaseHeader) -> bool {

@@ -48,30 +48,15 @@ newton_max_it = 60
 
 /// (x0, y0, σxx, cu) of every particle of a checkpoint, read back by h5py.
 fn particles(file: &Path) -> Vec<[f64; 4]> {
-    let script = format!(
-        "import h5py\nf = h5py.File({:?}, 'r')\nd = f['particles/state']\n\
+    let rows = h5py_rows(
+        file,
+        "d = f['particles/state']\n\
          names = [n if isinstance(n, str) else n.decode() for n in d.attrs['names']]\n\
          s = d[...]\nx = f['particles/position'][...] - f['particles/displacement'][...]\n\
          for i in range(len(s)):\n    \
          print(x[i, 0], x[i, 1], s[i, names.index('stress_xx')], s[i, names.index('cu')])",
-        file.display().to_string()
     );
-    let out = std::process::Command::new("python3")
-        .args(["-c", &script])
-        .output()
-        .expect("python3");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .map(|l| {
-            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-            [v[0], v[1], v[2], v[3]]
-        })
-        .collect()
+    rows.iter().map(|v| [v[0], v[1], v[2], v[3]]).collect()
 }
 
 #[test]
@@ -190,39 +175,25 @@ columns = [{ name = "area", measure = "area" }, { name = "base_fy", measure = "r
 
 /// Reference positions and triangles of the first field frame.
 fn frame(dir: &Path) -> (Vec<[f64; 2]>, Vec<[usize; 3]>) {
-    let script = "import h5py, os, sys\nd = sys.argv[1]\n\
-        f = h5py.File(os.path.join(d, sorted(os.listdir(d))[0]), 'r')\n\
-        x = f['geometry'][...] - f['point_data/displacement'][:, :2]\n\
-        print(len(x))\n\
-        for p in x: print(p[0], p[1])\n\
-        for t in f['connectivity'][...]: print(t[0], t[1], t[2])";
-    let out = std::process::Command::new("python3")
-        .args(["-c", script, &dir.join("fields").display().to_string()])
-        .output()
-        .expect("python3");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let fields = dir.join("fields");
+    let mut files: Vec<_> = std::fs::read_dir(&fields)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    let rows = h5py_rows(
+        &files[0],
+        "x = f['geometry'][...] - f['point_data/displacement'][:, :2]\n\
+         for p in x: print(p[0], p[1])\n\
+         for t in f['connectivity'][...]: print(t[0], t[1], t[2])",
     );
-    let text = String::from_utf8_lossy(&out.stdout);
-    let mut lines = text.lines();
-    let n: usize = lines.next().unwrap().parse().unwrap();
-    let mut x = Vec::new();
-    let mut t = Vec::new();
-    for (k, l) in lines.enumerate() {
-        let v: Vec<&str> = l.split_whitespace().collect();
-        if k < n {
-            x.push([v[0].parse().unwrap(), v[1].parse().unwrap()]);
-        } else {
-            t.push([
-                v[0].parse().unwrap(),
-                v[1].parse().unwrap(),
-                v[2].parse().unwrap(),
-            ]);
-        }
-    }
-    (x, t)
+    let x = rows.iter().filter(|r| r.len() == 2).map(|r| [r[0], r[1]]);
+    let t = rows.iter().filter(|r| r.len() == 3);
+    (
+        x.collect(),
+        t.map(|r| [r[0] as usize, r[1] as usize, r[2] as usize])
+            .collect(),
+    )
 }
 
 #[test]
@@ -392,31 +363,12 @@ newton_max_it = 60
 
 /// (x, y, material) of every particle of a checkpoint.
 fn placed(file: &Path) -> Vec<(f64, f64, u32)> {
-    let script = format!(
-        "import h5py\nf = h5py.File({:?}, 'r')\nx = f['particles/position'][...]\n\
-         m = f['particles/material'][...]\nfor i in range(len(m)): print(x[i, 0], x[i, 1], m[i])",
-        file.display().to_string()
+    let rows = h5py_rows(
+        file,
+        "x = f['particles/position'][...]\nm = f['particles/material'][...]\n\
+         for i in range(len(m)): print(x[i, 0], x[i, 1], m[i])",
     );
-    let out = std::process::Command::new("python3")
-        .args(["-c", &script])
-        .output()
-        .expect("python3");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .map(|l| {
-            let v: Vec<&str> = l.split_whitespace().collect();
-            (
-                v[0].parse().unwrap(),
-                v[1].parse().unwrap(),
-                v[2].parse().unwrap(),
-            )
-        })
-        .collect()
+    rows.iter().map(|v| (v[0], v[1], v[2] as u32)).collect()
 }
 
 #[test]
@@ -572,28 +524,13 @@ fn column_weight(y: f64) -> f64 {
 
 /// (x0, y0, σxx, σyy) of every particle of a case file.
 fn column_stresses(file: &Path) -> Vec<[f64; 4]> {
-    let script = format!(
-        "import h5py\nf = h5py.File({:?}, 'r')\ns = f['particles/state'][...]\n\
+    let rows = h5py_rows(
+        file,
+        "s = f['particles/state'][...]\n\
          x = f['particles/position'][...] - f['particles/displacement'][...]\n\
          for i in range(len(s)): print(x[i, 0], x[i, 1], s[i, 0], s[i, 1])",
-        file.display().to_string()
     );
-    let out = std::process::Command::new("python3")
-        .args(["-c", &script])
-        .output()
-        .expect("python3");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .map(|l| {
-            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-            [v[0], v[1], v[2], v[3]]
-        })
-        .collect()
+    rows.iter().map(|v| [v[0], v[1], v[2], v[3]]).collect()
 }
 
 #[test]

@@ -356,17 +356,7 @@ fn check_alignment(s: &Scene) -> Result<(), Invalid> {
     let h = s.mesh.h;
     if s.body.rectangles.is_empty() {
         let [lo, hi] = s.bounding_box();
-        let upper = ((hi[0] - lo[0]) / h + 2.0) * ((hi[1] - lo[1]) / h + 2.0);
-        if upper > MAX_PARTICLES as f64 {
-            return fail(
-                FieldPath::key("mesh").join("h"),
-                format!(
-                    "h = {h} would create about {upper:.3e} particles, more than the limit of \
-                     {MAX_PARTICLES} ({LIMIT_REASON})"
-                ),
-            );
-        }
-        return Ok(());
+        return particle_limit(h, ((hi[0] - lo[0]) / h + 2.0) * ((hi[1] - lo[1]) / h + 2.0));
     }
     let anchor = s.body.rectangles[0].origin;
     let rects = FieldPath::key("body").join("rectangles");
@@ -403,6 +393,11 @@ fn check_alignment(s: &Scene) -> Result<(), Invalid> {
         .iter()
         .map(|r| super::validate_fine::lattice_count(r.size, h))
         .sum();
+    particle_limit(h, upper)
+}
+
+/// At most [`MAX_PARTICLES`], `upper` bounding the count that spacing `h` makes.
+fn particle_limit(h: f64, upper: f64) -> Result<(), Invalid> {
     if upper > MAX_PARTICLES as f64 {
         return fail(
             FieldPath::key("mesh").join("h"),

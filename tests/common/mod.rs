@@ -125,3 +125,27 @@ pub fn cantilever_case(dir: &Path, h: &str, steps: u32, sets: &[&str]) {
 pub fn small_cantilever(dir: &Path, steps: u32, sets: &[&str]) {
     cantilever_case(dir, "0.25", steps, sets);
 }
+
+/// Runs the Python `body` with h5py and the HDF5 file open as `f` (read-only) and returns every
+/// line it printed as numbers.
+pub fn h5py_rows(file: &Path, body: &str) -> Vec<Vec<f64>> {
+    let script = format!("import h5py, sys\nf = h5py.File(sys.argv[1], 'r')\n{body}");
+    let out = Command::new("python3")
+        .args(["-c", &script, &file.display().to_string()])
+        .output()
+        .expect("python3");
+    assert!(
+        out.status.success(),
+        "h5py on {}: {}",
+        file.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| {
+            l.split_whitespace()
+                .map(|x| x.parse().unwrap_or_else(|e| panic!("{x:?}: {e}")))
+                .collect()
+        })
+        .collect()
+}
