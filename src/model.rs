@@ -41,7 +41,7 @@ pub fn materials_of(scene: &Scene) -> Result<Vec<Box<dyn Material>>, String> {
         })?;
         out.push(match all.len() {
             1 => model,
-            _ => Box::new(Placed::new(model, &layout)) as Box<dyn Material>,
+            _ => Box::new(Placed::new(model, &layout)?) as Box<dyn Material>,
         });
     }
     Ok(out)

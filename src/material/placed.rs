@@ -36,21 +36,26 @@ pub fn union_layout<'a>(models: impl IntoIterator<Item = &'a [InternalVar]>) -> 
 }
 
 impl Placed {
-    pub fn new(inner: Box<dyn Material>, union: &StateLayout) -> Placed {
+    /// `inner` in `union`, which must hold every variable of `inner` ([`union_layout`]).
+    pub fn new(inner: Box<dyn Material>, union: &StateLayout) -> Result<Placed, String> {
         let mut map = Vec::new();
         for v in inner.internal_variables() {
-            let (at, _) = union
-                .find(&v.name)
-                .expect("the union holds every model's variables");
+            let Some((at, _)) = union.find(&v.name) else {
+                return Err(format!(
+                    "model \"{}\" keeps `{}`, which the scene's state layout lacks",
+                    inner.name(),
+                    v.name
+                ));
+            };
             map.extend((0..v.kind.width()).map(|k| at - STRESS_LEN + k));
         }
         let identity = map.iter().enumerate().all(|(i, &j)| i == j);
-        Placed {
+        Ok(Placed {
             inner,
             vars: union.vars().to_vec(),
             map: (!identity).then_some(map),
             union_len: union.internal_len(),
-        }
+        })
     }
 
     /// The state as `inner` lays it out.
@@ -159,8 +164,8 @@ mod tests {
         let e = LinearElastic::new(1e7, 0.3).unwrap();
         let union = union_layout([e.internal_variables(), t.internal_variables()]);
         assert_eq!(union.len(), 9);
-        let elastic = Placed::new(Box::new(e), &union);
-        let tresca = Placed::new(Box::new(t), &union);
+        let elastic = Placed::new(Box::new(e), &union).unwrap();
+        let tresca = Placed::new(Box::new(t), &union).unwrap();
         assert_eq!(elastic.internal_variables().len(), 2);
         // The elastic law leaves the plastic columns it meets as they were.
         let mut s = GaussState::stressed([0.0; 4], 5);

@@ -365,8 +365,8 @@ impl LinearSolver<'_> {
                         return super::yield_zone::install(pc, std::ptr::null_mut(), pc, "");
                     }
                     set_pc_type(pc, "gamg")?;
-                    // native-stack.md pitfall 4: reused GAMG interpolation once gave an
-                    // indefinite preconditioner on the second Newton iteration.
+                    // Reused GAMG interpolation once gave CG an indefinite preconditioner on
+                    // the second Newton iteration (DIVERGED_INDEFINITE_PC, PETSc 3.18).
                     check(
                         ffi::PCGAMGSetReuseInterpolation(pc, ffi::PetscBool_PETSC_FALSE),
                         "PCGAMGSetReuseInterpolation",
@@ -606,8 +606,8 @@ unsafe fn configure_coarse(coarse_ksp: ffi::KSP, coarse: &Mat) -> Result<(), Pet
         // The coarse operator is the Galerkin product of each Newton iterate's tangent: GAMG
         // aggregates once per increment and only redoes its products on the next iterations.
         // Its smoothers then estimate their eigenvalues afresh instead of keeping the first
-        // aggregation's (a stale bound is how reused GAMG became indefinite, native-stack.md
-        // pitfall 4).
+        // aggregation's (a stale bound is how reused GAMG became indefinite: CG stopped with
+        // DIVERGED_INDEFINITE_PC on the second Newton iteration).
         check(
             ffi::PCGAMGSetReuseInterpolation(coarse_pc, ffi::PetscBool_PETSC_TRUE),
             "PCGAMGSetReuseInterpolation",

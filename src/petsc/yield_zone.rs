@@ -136,7 +136,7 @@ pub(super) unsafe fn install(
         )?;
         let gamg = cstring("gamg")?;
         check(ffi::PCSetType(z.amg, gamg.as_ptr()), "PCSetType(gamg)")?;
-        // native-stack.md pitfall 4, as for GAMG alone.
+        // Reused interpolation once made GAMG indefinite (as for GAMG alone, linear.rs).
         check(
             ffi::PCGAMGSetReuseInterpolation(z.amg, ffi::PetscBool_PETSC_FALSE),
             "PCGAMGSetReuseInterpolation",

@@ -1,5 +1,5 @@
 //! Which picture `history.png` is: a legacy kind's (fixed columns, with the reference solutions
-//! of `shared/reference.md`) or the scene's declared columns' (with the scene's own reference
+//! of `docs/reference.md`) or the scene's declared columns' (with the scene's own reference
 //! lines).
 
 use std::path::Path;

@@ -1,5 +1,5 @@
 //! The load–displacement pictures of the three legacy history kinds (`history.kind` =
-//! cantilever, footing, block), with the reference solutions of `shared/reference.md` drawn
+//! cantilever, footing, block), with the reference solutions of `docs/reference.md` drawn
 //! alongside the run's results. Their columns are fixed, so the references are too.
 
 use std::path::Path;

@@ -2,7 +2,7 @@
 //!
 //! - `history.png`, from `DIR/history.csv` and the run's scene `DIR/scene.toml` (when the run
 //!   wrote one). A legacy history kind gets its fixed picture, with the reference solutions of
-//!   `shared/reference.md`, when the header is that kind's and the scene asked for the kind (or
+//!   `docs/reference.md`, when the header is that kind's and the scene asked for the kind (or
 //!   there is no `scene.toml`: runs from before it was written):
 //!   - cantilever: u/L and v/L against λ = P L²/(E I), with the Bisshopp–Drucker elastica
 //!     (dashed) and the plane-strain Reissner beam at λ = 2, 5, 10 (crosses);

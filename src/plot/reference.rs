@@ -1,4 +1,4 @@
-//! Reference solutions drawn with the results (`shared/reference.md`).
+//! Reference solutions drawn with the results (`docs/reference.md`).
 
 use std::f64::consts::PI;
 
