@@ -54,6 +54,8 @@ pub mod builtin;
 mod error;
 #[path = "scene/field_path.rs"]
 pub mod field_path;
+#[path = "scene/gmsh_body.rs"]
+mod gmsh_body;
 #[path = "scene/lattice.rs"]
 pub mod lattice;
 #[path = "scene/overrides.rs"]
@@ -93,9 +95,9 @@ pub use rigid::{
     SurfacePressure,
 };
 pub use schema::{
-    Body, Dof, ElementChoice, FineRegion, Fixed, Gravity, History, HistoryKind, LineSearch,
-    LinearChoice, Material, MaterialModel, Mesh, Output, PointLoad, Prescribed, Rectangle, Scene,
-    Selection, Solver, Steps,
+    Body, Dof, ElementChoice, FineRegion, Fixed, Gravity, History, HistoryKind, ImportedNode,
+    LineSearch, LinearChoice, Material, MaterialModel, Mesh, Output, PointLoad, Prescribed,
+    Rectangle, Scene, Selection, Solver, Steps,
 };
 pub use selector::{Axis, Comparison, Condition, Selector};
 
@@ -168,6 +170,7 @@ impl Scene {
             field: Some(path.to_string()),
             ..SceneError::new(source, message)
         };
+        gmsh_body::import(&mut scene, source).map_err(invalid)?;
         scene.steps.count =
             validate_rigid::check_stages(&scene, scene.steps.count != 0).map_err(invalid)?;
         validate::validate(&scene).map_err(invalid)?;

@@ -81,6 +81,14 @@ pub fn particle_count(scene: &Scene) -> u64 {
 pub fn generate_particles(scene: &Scene) -> ParticleSet {
     let h = scene.mesh.h;
     let width = crate::model::state_layout(scene).len();
+    if let Some(nodes) = &scene.body.imported_nodes {
+        let mut set = ParticleSet::with_capacity(nodes.len(), width);
+        for (gid, n) in nodes.iter().enumerate() {
+            set.push_new(gid as u64, n.position, n.h);
+            set.material[gid] = n.material;
+        }
+        return finish(scene, set);
+    }
     if !scene.body.zones.is_empty() {
         return finish(scene, super::zones::fill(scene, width));
     }
@@ -138,10 +146,11 @@ fn carve_rigid(scene: &Scene, base: ParticleSet) -> ParticleSet {
     let shapes: Vec<_> = (0..scene.rigid.len())
         .filter_map(|i| super::validate_rigid::shape_of(scene, i).ok())
         .collect();
+    let zones = super::zones::shapes(scene).unwrap_or_default();
     let strictly_inside = |p: [f64; 2], margin: f64| {
         scene.body.rectangles.iter().any(|r| {
             (0..2).all(|c| p[c] > r.origin[c] + margin && p[c] < r.origin[c] + r.size[c] - margin)
-        })
+        }) || super::zones::deep_inside(&zones, p, margin)
     };
     let mut ring: Vec<([f64; 2], f64)> = Vec::new();
     for shape in &shapes {
@@ -173,21 +182,29 @@ fn carve_rigid(scene: &Scene, base: ParticleSet) -> ParticleSet {
             );
         }
     }
-    let mut points: Vec<([f64; 2], f64)> = Vec::with_capacity(base.len() + ring.len());
-    for (p, h) in base.position.iter().zip(&base.h) {
+    // A lining particle takes the material of the nearest particle it replaces or joins.
+    let nearest_material = |q: [f64; 2]| {
+        (base.position.iter().zip(&base.material))
+            .map(|(p, m)| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2), *m))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map_or(0, |(_, m)| m)
+    };
+    let mut points: Vec<([f64; 2], f64, u32)> = Vec::with_capacity(base.len() + ring.len());
+    for ((p, h), m) in base.position.iter().zip(&base.h).zip(&base.material) {
         let inside = shapes.iter().any(|s| s.closest(*p).distance < -tol);
         let crowded = ring
             .iter()
             .any(|(q, hq)| (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) < 0.25 * hq * hq);
         if !inside && !crowded {
-            points.push((*p, *h));
+            points.push((*p, *h, *m));
         }
     }
-    points.extend(ring);
+    points.extend(ring.into_iter().map(|(q, h)| (q, h, nearest_material(q))));
     points.sort_by(|a, b| a.0[1].total_cmp(&b.0[1]).then(a.0[0].total_cmp(&b.0[0])));
     let mut set = ParticleSet::with_capacity(points.len(), base.state.width());
-    for (gid, (p, h)) in points.into_iter().enumerate() {
+    for (gid, (p, h, m)) in points.into_iter().enumerate() {
         set.push_new(gid as u64, p, h);
+        set.material[gid] = m;
     }
     set
 }

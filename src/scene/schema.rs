@@ -76,6 +76,24 @@ pub struct Body {
     /// it) inside, lattice points closer than h/2 to a boundary dropped.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub zones: Vec<Zone>,
+    /// `mesh = "site.msh"`: the body imported from a 2D Gmsh mesh (MSH 4.1, ASCII or binary;
+    /// the path relative to the scene file). Every node of a physical surface becomes a particle
+    /// whose spacing is the mean length of the mesh edges at the node; each physical surface
+    /// becomes zones (one per outline, holes included) of the `[[material]]` of the same name, or
+    /// of the material that a `[[body.zones]]` entry with that `name` and no shape names (with
+    /// one material, every surface is of it); each physical curve names the zone edges it runs
+    /// along, for `on = "..."` selections. Instead of `rectangles`; `new` resolves it into
+    /// `zones` and `imported`, so a case file never needs the mesh file again.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<String>,
+    /// Written by `new` in place of `mesh`: the Gmsh file the zones and particles came from. A
+    /// resolved scene given to `new` again (without `mesh`) fills those zones with the lattice
+    /// of spacing `mesh.h` instead.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub imported: Option<String>,
+    /// The nodes of `mesh`, read while the scene is loaded; never written.
+    #[serde(skip)]
+    pub imported_nodes: Option<std::sync::Arc<Vec<ImportedNode>>>,
     /// Random offset of every particle lying more than h/2 inside a rectangle, as a fraction of
     /// its spacing h (the finer one inside `[[mesh.fine]]` regions) in each direction (0 <=
     /// jitter < 0.5; default 0). Deterministic per particle id. An irregular cloud has no grid
@@ -109,10 +127,23 @@ pub struct Zone {
     /// "seabed"` picks the particles on the edges of that name. Optional.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub edges: Vec<String>,
+    /// Names of the edges of each hole, as `edges` for the outer ring. Optional.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub hole_edges: Vec<Vec<String>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub circle: Option<CircleZone>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rectangle: Option<Rectangle>,
+}
+
+/// A particle of a body imported from Gmsh: a mesh node.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImportedNode {
+    pub position: [f64; 2],
+    /// The local mesh size (m).
+    pub h: f64,
+    /// Index into the scene's `[[material]]` list.
+    pub material: u32,
 }
 
 /// `circle = { centre = [x, y], radius = r }` (m).

@@ -22,9 +22,14 @@ pub fn shape(z: &Zone, at: &FieldPath) -> Result<Shape, (FieldPath, String)> {
     }
     let finite = |p: &[f64; 2]| p.iter().all(|x| x.is_finite());
     if z.polygon.is_none() {
-        let key = match (z.holes.is_empty(), z.edges.is_empty()) {
-            (false, _) => Some("holes"),
-            (_, false) => Some("edges"),
+        let key = match (
+            z.holes.is_empty(),
+            z.edges.is_empty(),
+            z.hole_edges.is_empty(),
+        ) {
+            (false, _, _) => Some("holes"),
+            (_, false, _) => Some("edges"),
+            (_, _, false) => Some("hole_edges"),
             _ => None,
         };
         if let Some(key) = key {
@@ -59,8 +64,39 @@ pub fn shape(z: &Zone, at: &FieldPath) -> Result<Shape, (FieldPath, String)> {
             return Err((at.join("holes").at(h), format!("vertex {k} is not finite")));
         }
     }
-    let names = if z.edges.is_empty() {
-        Vec::new()
+    if z.hole_edges.len() > z.holes.len() {
+        return Err((
+            at.join("hole_edges"),
+            format!(
+                "names the edges of {} holes but the polygon has {}",
+                z.hole_edges.len(),
+                z.holes.len()
+            ),
+        ));
+    }
+    let named = |n: &String| (!n.trim().is_empty()).then(|| n.clone());
+    for (h, names) in z.hole_edges.iter().enumerate() {
+        if !names.is_empty() && names.len() != z.holes[h].len() {
+            return Err((
+                at.join("hole_edges").at(h),
+                format!(
+                    "names {} edges but hole {h} has {}",
+                    names.len(),
+                    z.holes[h].len()
+                ),
+            ));
+        }
+    }
+    let hole_names = z
+        .hole_edges
+        .iter()
+        .map(|names| names.iter().map(named).collect::<Vec<_>>());
+    let mut names = if z.edges.is_empty() {
+        if z.hole_edges.is_empty() {
+            Vec::new()
+        } else {
+            vec![Vec::new()]
+        }
     } else {
         if z.edges.len() != outer.len() {
             return Err((
@@ -72,9 +108,9 @@ pub fn shape(z: &Zone, at: &FieldPath) -> Result<Shape, (FieldPath, String)> {
                 ),
             ));
         }
-        let named = |n: &String| (!n.trim().is_empty()).then(|| n.clone());
         vec![z.edges.iter().map(named).collect()]
     };
+    names.extend(hole_names);
     geometry::Polygon::with_edge_names(outer, z.holes.clone(), names)
         .map(Shape::Polygon)
         .map_err(|e| (at.join("polygon"), e.to_string()))
@@ -188,8 +224,10 @@ pub fn unused_materials(scene: &Scene) -> Vec<String> {
         .collect()
 }
 
-/// Length of the vertical segment from (x, y0) up to (x, y1) inside `shape`.
-pub fn vertical_length_inside(shape: &Shape, x: f64, y0: f64, y1: f64) -> f64 {
+/// Length of the vertical segment from (x, y0) up to (x, y1) inside `shape`, as the limit from
+/// the left (`from_left`) or the right of x: on a vertical edge of a polygon the two differ, and
+/// the line itself crosses nothing.
+pub fn vertical_length_inside(shape: &Shape, x: f64, y0: f64, y1: f64, from_left: bool) -> f64 {
     let clip = |lo: f64, hi: f64| (hi.min(y1) - lo.max(y0)).max(0.0);
     match shape {
         Shape::Circle(c) => {
@@ -199,7 +237,12 @@ pub fn vertical_length_inside(shape: &Shape, x: f64, y0: f64, y1: f64) -> f64 {
         }
         Shape::Rectangle(r) => {
             let (o, s) = (r.origin(), r.size());
-            if x < o[0] || x > o[0] + s[0] {
+            let inside = if from_left {
+                x > o[0] && x <= o[0] + s[0]
+            } else {
+                x >= o[0] && x < o[0] + s[0]
+            };
+            if !inside {
                 0.0
             } else {
                 clip(o[1], o[1] + s[1])
@@ -207,12 +250,14 @@ pub fn vertical_length_inside(shape: &Shape, x: f64, y0: f64, y1: f64) -> f64 {
         }
         Shape::Polygon(p) => {
             // Where the line crosses the rings; an edge counts when it straddles x, one end
-            // on each side by the half-open rule, so a vertex on the line counts once.
+            // on each side by a half-open rule, so a vertex on the line counts once. Which
+            // end is closed picks the limit from the left or the right.
+            let left_of = |v: f64| if from_left { v < x } else { v <= x };
             let mut ys: Vec<f64> = Vec::new();
             for ring in std::iter::once(p.outer()).chain(p.holes().iter().map(|h| h.as_slice())) {
                 for k in 0..ring.len() {
                     let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
-                    if (a[0] <= x) != (b[0] <= x) {
+                    if left_of(a[0]) != left_of(b[0]) {
                         ys.push(a[1] + (x - a[0]) * (b[1] - a[1]) / (b[0] - a[0]));
                     }
                 }
@@ -234,14 +279,21 @@ pub fn geostatic(
     g: &super::rigid::Geostatic,
 ) -> [f64; 2] {
     let gravity = scene.gravity.g[0].hypot(scene.gravity.g[1]);
-    let mut weight = 0.0;
-    for (shape, zone) in shapes.iter().zip(&scene.body.zones) {
-        let m = zone
-            .material
-            .as_deref()
-            .and_then(|n| scene.material.index_of(n));
-        let density = scene.material.all()[m.unwrap_or(0)].density;
-        weight += density * gravity * vertical_length_inside(shape, x[0], x[1], g.surface);
+    // On a vertical boundary (the body's side, the face of a cut) the column is the one on the
+    // side where the body is: the larger of the two one-sided weights.
+    let mut weight: f64 = 0.0;
+    for from_left in [true, false] {
+        let mut side = 0.0;
+        for (shape, zone) in shapes.iter().zip(&scene.body.zones) {
+            let m = zone
+                .material
+                .as_deref()
+                .and_then(|n| scene.material.index_of(n));
+            let density = scene.material.all()[m.unwrap_or(0)].density;
+            let length = vertical_length_inside(shape, x[0], x[1], g.surface, from_left);
+            side += density * gravity * length;
+        }
+        weight = weight.max(side);
     }
     let holder = shapes.iter().position(|s| s.contains(x));
     let k0 = holder.and_then(|z| scene.body.zones[z].k0).unwrap_or(g.k0);

@@ -1,0 +1,200 @@
+//! A body imported from Gmsh (issue 27, item 3): `.geo` → `.msh` (by the `gmsh` that
+//! `.ci/install-native` installs) → `new` → run. Particles are the mesh nodes, physical surfaces
+//! are zones of their materials, physical curves are selections, and the case file no longer
+//! needs the mesh.
+
+mod common;
+use common::*;
+use std::path::Path;
+use std::process::Command;
+
+/// The committed site: 3 m of soft clay over 4 m of stiff clay, 20 m wide. Elastic layers under
+/// their own weight from the geostatic state: the stiff layer is named by its physical surface,
+/// the soft one claimed by a zone entry for material "light".
+const SITE: &str = r#"
+name = "gmsh-site"
+[body]
+mesh = "site.msh"
+zones = [{ name = "soft-clay", material = "light" }]
+[mesh]
+h = 1.0
+[[material]]
+name = "stiff-clay"
+model = "linear-elastic"
+young = 5.0e7
+poisson = 0.3
+density = 2000.0
+[[material]]
+name = "light"
+model = "linear-elastic"
+young = 1.0e7
+poisson = 0.3
+density = 1600.0
+[gravity]
+g = [0.0, -9.81]
+[geostatic]
+surface = 7.0
+k0 = 0.4285714285714286
+[[fixed]]
+on = "base"
+dofs = ["x", "y"]
+[[fixed]]
+on = "sides"
+dofs = ["x"]
+[steps]
+count = 3
+[history]
+columns = [{ name = "uy", measure = "probe.top.uy" }]
+[[probe]]
+name = "top"
+at = [10.0, 7.0]
+"#;
+
+/// Meshes the committed `.geo` into `dir/name` with Gmsh (`extra`: e.g. `-bin`).
+fn gmsh(dir: &Path, name: &str, extra: &[&str]) {
+    let geo = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/layered-site.geo");
+    let out = Command::new("gmsh")
+        .args(["-2", "-format", "msh41", "-clscale", "1"])
+        .args(extra)
+        .arg(&geo)
+        .arg("-o")
+        .arg(dir.join(name))
+        .output()
+        .expect("gmsh is installed by .ci/install-native");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The node count of a MSH 4.1 file: the second number after `$Nodes` (ASCII), or from the
+/// same header of a binary file, which Gmsh writes as text.
+fn node_count(file: &Path) -> u64 {
+    let bytes = std::fs::read(file).unwrap();
+    let at = bytes.windows(7).position(|w| w == b"$Nodes\n").unwrap() + 7;
+    let text = String::from_utf8_lossy(&bytes[at..at + 200]);
+    if text.starts_with(|c: char| c.is_ascii_digit()) {
+        return text.split_whitespace().nth(1).unwrap().parse().unwrap();
+    }
+    // Binary: four size_t (8 bytes) numbers.
+    u64::from_le_bytes(bytes[at + 8..at + 16].try_into().unwrap())
+}
+
+fn particles_written(stdout: &str) -> u64 {
+    let (_, rest) = stdout.split_once(" (").unwrap();
+    rest.split_whitespace().next().unwrap().parse().unwrap()
+}
+
+/// (y0, σyy, material) of every particle of a case file.
+fn stresses(file: &Path) -> Vec<(f64, f64, u32)> {
+    let rows = h5py_rows(
+        file,
+        "s = f['particles/state'][...]\nm = f['particles/material'][...]\n\
+         x = f['particles/position'][...] - f['particles/displacement'][...]\n\
+         for i in range(len(s)): print(x[i, 1], s[i, 1], m[i])",
+    );
+    rows.iter().map(|v| (v[0], v[1], v[2] as u32)).collect()
+}
+
+fn weight_above(y: f64) -> f64 {
+    let above = |lo: f64, hi: f64| (hi - y.max(lo)).max(0.0);
+    -9.81 * (2000.0 * above(0.0, 4.0) + 1600.0 * above(4.0, 7.0))
+}
+
+#[test]
+fn a_site_meshed_in_gmsh_runs_from_its_nodes_and_physical_groups() {
+    let dir = workdir("gmsh-site");
+    std::fs::write(dir.join("site.toml"), SITE).unwrap();
+    for (msh, extra) in [("site.msh", &[][..]), ("binary.msh", &["-bin"][..])] {
+        gmsh(&dir, msh, extra);
+        let toml = SITE.replace("site.msh", msh);
+        std::fs::write(dir.join("s.toml"), toml).unwrap();
+        let out = ok(&dir, 1, &["new", "s.toml", "-o", "s.h5"]);
+        assert_eq!(
+            particles_written(&out),
+            node_count(&dir.join(msh)),
+            "{msh}: one particle per node"
+        );
+    }
+    // The binary and ASCII files give the same case; the case needs no mesh file any more.
+    let out = ok(&dir, 1, &["new", "site.toml", "-o", "site.h5"]);
+    std::fs::remove_file(dir.join("site.msh")).unwrap();
+    let info = ok(&dir, 1, &["info", "site.h5"]);
+    assert!(info.contains("\"light\""), "{info}");
+    ok(&dir, 2, &["site.h5", "--out", "r"]);
+    let n = particles_written(&out);
+    let scale = -weight_above(0.0);
+    for file in [
+        dir.join("site.h5"),
+        dir.join("r/checkpoints/step_000003.h5"),
+    ] {
+        let rows = stresses(&file);
+        assert_eq!(rows.len() as u64, n);
+        let mut worst: f64 = 0.0;
+        for (y, syy, m) in &rows {
+            worst = worst.max((syy - weight_above(*y)).abs() / scale);
+            // An interface node belongs to the surface of the lower tag: stiff-clay (tag 1).
+            let want = if *y <= 4.0 + 1e-9 { 0 } else { 1 };
+            assert_eq!(*m, want, "material of the particle at y = {y}");
+        }
+        println!(
+            "{}: largest |σyy − weight above| / weight = {worst:.2e}",
+            file.display()
+        );
+        assert!(worst < 1e-9, "{worst:e}");
+    }
+    let (_, rows) = history(&dir.join("r/history.csv"));
+    let uy = rows.last().unwrap()[1];
+    assert!(
+        uy.abs() < 1e-9,
+        "the geostatic site must not move: uy = {uy}"
+    );
+}
+
+#[test]
+fn bad_gmsh_bodies_are_refused_naming_the_file_and_field() {
+    let dir = workdir("gmsh-bad");
+    gmsh(&dir, "site.msh", &[]);
+    let cases: [(&str, &str, &str); 4] = [
+        (
+            "mesh = \"site.msh\"",
+            "mesh = \"missing.msh\"",
+            "missing.msh: mesh file not found",
+        ),
+        (
+            "zones = [{ name = \"soft-clay\", material = \"light\" }]",
+            "",
+            "physical surface \"soft-clay\" is claimed by no [[material]]",
+        ),
+        (
+            "name = \"soft-clay\", material = \"light\"",
+            "name = \"sand\", material = \"light\"",
+            "\"sand\" is no physical surface",
+        ),
+        ("on = \"sides\"", "on = \"flanks\"", "flanks"),
+    ];
+    for (from, to, message) in cases {
+        std::fs::write(dir.join("bad.toml"), SITE.replace(from, to)).unwrap();
+        let out = run(&dir, 1, &["new", "bad.toml", "-o", "bad.h5"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{to}: accepted");
+        assert!(err.contains(message), "{to}: {err}");
+        assert!(err.contains("bad.toml"), "{to}: the scene is named: {err}");
+        assert!(!dir.join("bad.h5").exists(), "{to}: nothing is written");
+    }
+    std::fs::write(
+        dir.join("damaged.msh"),
+        "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2",
+    )
+    .unwrap();
+    let text = SITE.replace("site.msh", "damaged.msh");
+    std::fs::write(dir.join("bad.toml"), text).unwrap();
+    let out = run(&dir, 1, &["new", "bad.toml", "-o", "bad.h5"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("damaged.msh"),
+        "{err}"
+    );
+    assert!(err.contains("body.mesh"), "the field is named: {err}");
+}
