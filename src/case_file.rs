@@ -126,13 +126,19 @@ pub struct CaseHeader {
 /// nearest to its `at` point (ties go to the smaller gid).
 pub fn new_case(scene: &Scene, source: &str) -> (CaseHeader, ParticleSet) {
     let mut particles = generate_particles(scene);
-    // Point loads' particles, then the probes'.
+    // Point loads' particles, then the probes' (on their boundary, if named).
+    let boundaries = crate::model::named_boundaries(scene);
+    let on = |name: Option<&str>, x: [f64; 2]| {
+        name.is_none_or(|n| crate::model::on_boundary(&boundaries, n, x, scene.mesh.h))
+    };
     let tracked_gids = scene
         .point_load
         .iter()
-        .map(|p| p.at)
-        .chain(scene.probe.iter().map(|p| p.at))
-        .filter_map(|at| lattice::nearest(&particles, at).map(|(gid, _)| gid))
+        .map(|p| (p.at, None))
+        .chain(scene.probe.iter().map(|p| (p.at, p.on.as_deref())))
+        .filter_map(|(at, name)| {
+            lattice::nearest_of(&particles, at, |x| on(name, x)).map(|(gid, _)| gid)
+        })
         .collect();
     // A scene that fails here fails again, with its message, when the case is loaded.
     if let Ok(materials) = crate::model::materials_of(scene) {

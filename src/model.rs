@@ -261,7 +261,7 @@ impl Model {
     }
 
     /// Whether `x0` lies on the named boundary (true without a name).
-    fn on(&self, name: Option<&str>, x0: [f64; 2]) -> bool {
+    pub fn on(&self, name: Option<&str>, x0: [f64; 2]) -> bool {
         name.is_none_or(|n| on_boundary(&self.boundaries, n, x0, self.scene.mesh.h))
     }
 

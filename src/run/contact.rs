@@ -75,8 +75,8 @@ impl Simulation {
             ));
             for (k, sp) in model.scene.surface_pressure.iter().enumerate() {
                 let inside = |p: u32| {
-                    sp.region
-                        .matches(self.reference_position(mesh, p as usize), model.tol)
+                    let x0 = self.reference_position(mesh, p as usize);
+                    sp.region.matches(x0, model.tol) && model.on(sp.on.as_deref(), x0)
                 };
                 if inside(a) && inside(b) {
                     out.surface.push(([na, m, nb], sp.pressure));
@@ -221,12 +221,19 @@ impl Simulation {
         let counts: Vec<f64> = edges.iter().map(|&n| n as f64).collect();
         let counts = pfem_partition::sum_f64(world, &counts);
         match counts.iter().position(|&n| n == 0.0) {
-            Some(k) => Err(super::step::SolveError::Fatal(format!(
-                "step {step}: surface_pressure[{k}].where = \"{}\" selects no boundary edge of \
-                 the body (edges whose two ends started in it): its pressure would act on \
-                 nothing",
-                self.model.scene.surface_pressure[k].region
-            ))),
+            Some(k) => {
+                let sp = &self.model.scene.surface_pressure[k];
+                let what = match (&sp.on, sp.region.is_all()) {
+                    (Some(on), true) => format!("on = \"{on}\""),
+                    (Some(on), false) => format!("where = \"{}\" on \"{on}\"", sp.region),
+                    (None, _) => format!("where = \"{}\"", sp.region),
+                };
+                Err(super::step::SolveError::Fatal(format!(
+                    "step {step}: surface_pressure[{k}].{what} selects no boundary edge of the \
+                     body (edges whose two ends started on it): its pressure would act on \
+                     nothing"
+                )))
+            }
             None => Ok(()),
         }
     }

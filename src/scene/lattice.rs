@@ -282,8 +282,20 @@ fn jittered(scene: &Scene, gid: u64, p: [f64; 2], h: f64) -> [f64; 2] {
 
 /// Global id of the particle nearest to `p` (ties go to the smaller id), with its distance.
 pub fn nearest(set: &ParticleSet, p: [f64; 2]) -> Option<(u64, f64)> {
+    nearest_of(set, p, |_| true)
+}
+
+/// As [`nearest`], among the particles whose position passes `keep`.
+pub fn nearest_of(
+    set: &ParticleSet,
+    p: [f64; 2],
+    keep: impl Fn([f64; 2]) -> bool,
+) -> Option<(u64, f64)> {
     let mut best: Option<(u64, f64)> = None;
     for (gid, q) in set.gid.iter().zip(&set.position) {
+        if !keep(*q) {
+            continue;
+        }
         let d2 = (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2);
         let better = match best {
             None => true,

@@ -116,8 +116,17 @@ impl Default for Contact {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SurfacePressure {
-    #[serde(rename = "where")]
+    /// Optional with `on`; at least one of the two.
+    #[serde(
+        rename = "where",
+        default = "Selector::all",
+        skip_serializing_if = "Selector::is_all"
+    )]
     pub region: Selector,
+    /// `on = "crest"`: the boundary edges whose two ends started on the named boundary (a zone
+    /// edge name or a Gmsh physical curve), and in `where` if given too.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub on: Option<String>,
     /// Pa.
     pub pressure: f64,
 }
@@ -142,12 +151,16 @@ fn one() -> f64 {
 }
 
 /// `[[probe]]`: a particle whose displacement history measures read (`probe.NAME.ux`): the one
-/// nearest to `at` when the case is created, like a point load's.
+/// nearest to `at` when the case is created (on the boundary `on` if given), like a point
+/// load's.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Probe {
     pub name: String,
     pub at: [f64; 2],
+    /// `on = "crest"`: the nearest particle to `at` among those on the named boundary.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub on: Option<String>,
 }
 
 /// `[[history.columns]]`: one column of `history.csv`, `scale * measure`.

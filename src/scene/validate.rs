@@ -483,6 +483,22 @@ fn check_against_particles(s: &Scene) -> Result<(), Invalid> {
         }
         check_selects_something(entry, (&p.region, p.on.as_deref()), &boundaries, s, x)?;
     }
+    for (i, sp) in s.surface_pressure.iter().enumerate() {
+        let entry = FieldPath::key("surface_pressure").at(i);
+        check_selects_something(entry, (&sp.region, sp.on.as_deref()), &boundaries, s, x)?;
+    }
+    for (i, p) in s.probe.iter().enumerate() {
+        if p.on.is_some() {
+            let entry = FieldPath::key("probe").at(i);
+            check_selects_something(
+                entry,
+                (&Selector::all(), p.on.as_deref()),
+                &boundaries,
+                s,
+                x,
+            )?;
+        }
+    }
     super::validate_loads::check(s, &particles)?;
     super::validate_motion::check(s, &particles)?;
     // The particle a point load goes to (`lattice::nearest`, ties to the smaller id).

@@ -23,16 +23,19 @@ fn check_on_body(
     path: FieldPath,
     at: [f64; 2],
 ) -> Result<(), Invalid> {
-    let Some((_, dist)) = lattice::nearest(particles, at) else {
+    let Some((gid, dist)) = lattice::nearest(particles, at) else {
         return Ok(());
     };
-    if dist > s.mesh.h * (1.0 + 1e-9) {
+    // An imported node's own spacing may exceed mesh.h.
+    let h = (particles.gid.iter().position(|&g| g == gid))
+        .map_or(s.mesh.h, |i| particles.h[i].max(s.mesh.h));
+    if dist > h * (1.0 + 1e-9) {
         return fail(
             path,
             format!(
                 "[{}, {}] is {dist:.4} m from the nearest particle; it must lie within one \
-                 particle spacing ({}) of the body",
-                at[0], at[1], s.mesh.h
+                 particle spacing ({h}) of the body",
+                at[0], at[1]
             ),
         );
     }
@@ -73,12 +76,19 @@ fn check_surface_pressure(
     shapes: &[Shape],
 ) -> Result<(), Invalid> {
     let tol = s.tolerance();
+    let boundaries = crate::model::named_boundaries(s);
     for (k, sp) in s.surface_pressure.iter().enumerate() {
+        let on = |p: [f64; 2]| {
+            (sp.on.as_deref())
+                .is_none_or(|n| crate::model::on_boundary(&boundaries, n, p, s.mesh.h))
+        };
         let picked: Vec<([f64; 2], f64)> = particles
             .position
             .iter()
             .zip(&particles.h)
-            .filter(|(p, h)| sp.region.matches(**p, tol) && on_outline(s, shapes, **p, **h))
+            .filter(|(p, h)| {
+                sp.region.matches(**p, tol) && on(**p) && on_outline(s, shapes, **p, **h)
+            })
             .map(|(p, h)| (*p, *h))
             .collect();
         let edge = picked.iter().enumerate().any(|(i, (p, hp))| {
@@ -88,12 +98,16 @@ fn check_surface_pressure(
             })
         });
         if !edge {
+            let (key, what) = match (&sp.on, sp.region.is_all()) {
+                (Some(on), true) => ("on", format!("on = \"{on}\"")),
+                (Some(on), false) => ("where", format!("\"{}\" on \"{on}\"", sp.region)),
+                (None, _) => ("where", format!("\"{}\"", sp.region)),
+            };
             return fail(
-                FieldPath::key("surface_pressure").at(k).join("where"),
+                FieldPath::key("surface_pressure").at(k).join(key),
                 format!(
-                    "\"{}\" selects no boundary edge of the body ({} particle(s) of its outline): \
-                     the pressure would act on nothing",
-                    sp.region,
+                    "{what} selects no boundary edge of the body ({} particle(s) of its \
+                     outline): the pressure would act on nothing",
                     picked.len()
                 ),
             );
