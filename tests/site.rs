@@ -198,11 +198,41 @@ fn frame(dir: &Path) -> (Vec<[f64; 2]>, Vec<[usize; 3]>) {
 
 #[test]
 fn a_polygon_with_a_hole_is_meshed_to_its_shape() {
+    check_plate("plate-hole", PLATE);
+}
+
+/// A polygon `[[mesh.fine]]` region at half the spacing around the hole: the finer particles
+/// lie in it, and the mesh keeps the plate's shape as without it.
+#[test]
+fn a_polygon_region_refines_a_zone_body() {
     use pfem_mpi::geometry::{Polygon, Shape};
-    let dir = workdir("plate-hole");
+    let region = vec![[0.5, 0.5], [2.0, 0.7], [2.0, 2.3], [0.4, 2.2]];
+    let text = format!("{PLATE}\n[[mesh.fine]]\npolygon = {region:?}\nh = 0.05\n");
+    let dir = check_plate("plate-hole-fine", &text);
+    let shape = Shape::Polygon(Polygon::new(region, vec![]).unwrap());
+    let rows = h5py_rows(
+        &dir.join("p.h5"),
+        "x = f['particles/position'][...]\nh = f['particles/h'][...]\n\
+         for i in range(len(h)): print(x[i, 0], x[i, 1], h[i])",
+    );
+    let fine: Vec<&Vec<f64>> = rows.iter().filter(|r| r[2] < 0.075).collect();
+    println!("{} of {} particles at h = 0.05", fine.len(), rows.len());
+    // The region's area less the hole's, at h = 0.05: about 2.05 m² / 0.0025 m².
+    assert!(fine.len() > 600, "{}", fine.len());
+    for r in fine {
+        assert!(
+            shape.signed_distance([r[0], r[1]]) < 1e-9,
+            "{r:?} outside the region"
+        );
+    }
+}
+
+fn check_plate(name: &str, text: &str) -> std::path::PathBuf {
+    use pfem_mpi::geometry::{Polygon, Shape};
+    let dir = workdir(name);
     std::fs::write(
         dir.join("plate.toml"),
-        PLATE.replace(
+        text.replace(
             "name = \"plate-with-hole\"",
             "name = \"plate-with-hole\"\n[output]\nfields_every = 1",
         ),
@@ -264,6 +294,7 @@ fn a_polygon_with_a_hole_is_meshed_to_its_shape() {
         (fy - weight).abs() < 1e-9 * weight,
         "base reaction {fy}, weight {weight}"
     );
+    dir
 }
 
 /// Bad zones and boundaries: one clear error naming the file and the field, nothing written.
@@ -295,6 +326,26 @@ fn bad_zones_are_refused_with_the_field_named() {
             "{ name = \"plate\",",
             "{ name = \"other\", rectangle = { origin = [3.0, 0.0], size = [2.0, 2.0] } },\n  { name = \"plate\",",
             &["body.zones[1]", "overlaps", "body.zones[0] (\"other\")"],
+        ),
+        (
+            "[steps]",
+            "[[surface_pressure]]\non = \"top\"\npressure = 1.0\n[steps]",
+            &["surface_pressure[0].on", "\"top\" names no boundary", "base"],
+        ),
+        (
+            "[steps]",
+            "[[mesh.fine]]\npolygon = [[10.0, 10.0], [11.0, 10.0], [11.0, 11.0]]\nh = 0.05\n[steps]",
+            &["mesh.fine[0]", "outside the body"],
+        ),
+        (
+            "[steps]",
+            "[[mesh.fine]]\npolygon = [[1.0, 0.5], [2.0, 0.5], [2.0, 2.0]]\nh = 0.03\n[steps]",
+            &["mesh.fine[0].h", "whole number"],
+        ),
+        (
+            "[steps]",
+            "[[probe]]\nname = \"p\"\nat = [1.0, 0.0]\non = \"roof\"\n[steps]",
+            &["probe[0].on", "roof"],
         ),
     ];
     for (k, (from, to, needles)) in cases.iter().enumerate() {

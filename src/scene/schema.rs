@@ -146,6 +146,10 @@ pub struct ImportedNode {
     pub material: u32,
 }
 
+fn is_zero2(v: &[f64; 2]) -> bool {
+    *v == [0.0; 2]
+}
+
 /// `circle = { centre = [x, y], radius = r }` (m).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -163,14 +167,22 @@ pub struct Rectangle {
     pub size: [f64; 2],
 }
 
-/// `[[mesh.fine]]`: a rectangle of the body filled with a finer particle lattice.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// `[[mesh.fine]]`: a region of the body filled with a finer particle lattice: a rectangle
+/// (`origin`, `size`) or, in a body of `[[body.zones]]`, a `polygon`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FineRegion {
     /// Lower-left corner (m); origin and size are whole multiples of the next coarser spacing,
     /// so the coarse particles on the region's edges are also fine-lattice particles.
+    #[serde(default, skip_serializing_if = "is_zero2")]
     pub origin: [f64; 2],
+    #[serde(default, skip_serializing_if = "is_zero2")]
     pub size: [f64; 2],
+    /// Vertices `[[x, y], ...]` (m) of a simple polygon, instead of `origin` and `size` (zone
+    /// bodies only). Its outline carries particles at `h`; any `h` smaller than `mesh.h` that
+    /// divides it a whole number of times.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polygon: Option<Vec<[f64; 2]>>,
     /// Particle spacing inside (m), a whole fraction of the next coarser spacing.
     pub h: f64,
 }

@@ -164,16 +164,17 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
         }
         (true, false) => {
             super::zones::shapes(s)?;
-            if !s.mesh.fine.is_empty() {
+        }
+        (false, true) => {
+            if let Some(i) = s.mesh.fine.iter().position(|r| r.polygon.is_some()) {
                 return fail(
-                    root.join("mesh").join("fine"),
-                    "is not available with [[body.zones]] yet: give the body as rectangles, \
-                     or a finer mesh.h"
+                    root.join("mesh").join("fine").at(i).join("polygon"),
+                    "refines a body of [[body.zones]]; in a body of rectangles a region is a \
+                     rectangle (origin, size)"
                         .to_string(),
                 );
             }
         }
-        (false, true) => {}
     }
     for (i, r) in s.body.rectangles.iter().enumerate() {
         finite2(rects.at(i).join("origin"), r.origin)?;
@@ -204,7 +205,15 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
                 format!("must be smaller than mesh.h = {} (got {})", s.mesh.h, r.h),
             );
         }
-        if !(r.size[0] > 0.0
+        if r.polygon.is_some() {
+            if r.size != [0.0; 2] || r.origin != [0.0; 2] {
+                return fail(
+                    at.join("polygon"),
+                    "a region is a rectangle (origin, size) or a polygon, not both".to_string(),
+                );
+            }
+            super::zones::fine_region(r, &at)?;
+        } else if !(r.size[0] > 0.0
             && r.size[1] > 0.0
             && r.size.iter().chain(&r.origin).all(|x| x.is_finite()))
         {
@@ -484,8 +493,11 @@ fn check_against_particles(s: &Scene) -> Result<(), Invalid> {
         check_selects_something(entry, (&p.region, p.on.as_deref()), &boundaries, s, x)?;
     }
     for (i, sp) in s.surface_pressure.iter().enumerate() {
-        let entry = FieldPath::key("surface_pressure").at(i);
-        check_selects_something(entry, (&sp.region, sp.on.as_deref()), &boundaries, s, x)?;
+        // `where` alone is checked for a boundary edge with the other loads.
+        if sp.on.is_some() || sp.region.is_all() {
+            let entry = FieldPath::key("surface_pressure").at(i);
+            check_selects_something(entry, (&sp.region, sp.on.as_deref()), &boundaries, s, x)?;
+        }
     }
     for (i, p) in s.probe.iter().enumerate() {
         if p.on.is_some() {

@@ -81,6 +81,9 @@ fn check_fits(s: &Scene, i: usize, path: &FieldPath) -> Result<(), Invalid> {
 /// coarser lattice, and with the body's own lattice it stays under [`MAX_PARTICLES`], counted
 /// from the areas before any particle exists (a tiny `h` would otherwise fill memory first).
 pub fn check(s: &Scene) -> Result<(), Invalid> {
+    if !s.body.zones.is_empty() {
+        return check_in_zones(s);
+    }
     let fine = FieldPath::key("mesh").join("fine");
     let body = &s.body.rectangles;
     let mut total: f64 = body.iter().map(|r| lattice_count(r.size, s.mesh.h)).sum();
@@ -119,6 +122,51 @@ pub fn check(s: &Scene) -> Result<(), Invalid> {
             );
         }
         check_fits(s, i, &path)?;
+    }
+    Ok(())
+}
+
+/// Regions of a zone body: each lies (partly) in the body, its spacing divides `mesh.h` a whole
+/// number of times (its lattice nests in the body's), and the particles they would make,
+/// counted from the areas, stay under [`MAX_PARTICLES`].
+fn check_in_zones(s: &Scene) -> Result<(), Invalid> {
+    let fine = FieldPath::key("mesh").join("fine");
+    let zones = super::zones::shapes(s)?;
+    let mut total = super::zones::area(s) / (s.mesh.h * s.mesh.h);
+    for (i, r) in s.mesh.fine.iter().enumerate() {
+        let at = fine.at(i);
+        let shape = super::zones::fine_region(r, &at)?;
+        if !zones.iter().any(|z| crate::geometry::overlap(z, &shape)) {
+            return fail(
+                at,
+                "lies outside the body (it overlaps no zone)".to_string(),
+            );
+        }
+        let ratio = s.mesh.h / r.h;
+        if lattice::whole(ratio).is_none() {
+            return fail(
+                at.join("h"),
+                format!(
+                    "{} does not divide mesh.h = {} a whole number of times (ratio {ratio:.4}); \
+                     use e.g. {}",
+                    r.h,
+                    s.mesh.h,
+                    s.mesh.h / ratio.round().max(2.0)
+                ),
+            );
+        }
+        total += shape.area() / (r.h * r.h);
+        if total > MAX_PARTICLES as f64 {
+            return fail(
+                at.join("h"),
+                format!(
+                    "h = {} would bring the body to about {total:.3e} particles, more than the \
+                     limit of {MAX_PARTICLES} ({})",
+                    r.h,
+                    super::validate::LIMIT_REASON
+                ),
+            );
+        }
     }
     Ok(())
 }

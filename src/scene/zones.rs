@@ -116,6 +116,26 @@ pub fn shape(z: &Zone, at: &FieldPath) -> Result<Shape, (FieldPath, String)> {
         .map_err(|e| (at.join("polygon"), e.to_string()))
 }
 
+/// The shape of `[[mesh.fine]]` region `r` (at `at`): its polygon or its rectangle.
+pub fn fine_region(
+    r: &super::schema::FineRegion,
+    at: &FieldPath,
+) -> Result<Shape, (FieldPath, String)> {
+    match &r.polygon {
+        Some(p) => {
+            if let Some(k) = p.iter().position(|v| !v.iter().all(|x| x.is_finite())) {
+                return Err((at.join("polygon"), format!("vertex {k} is not finite")));
+            }
+            geometry::Polygon::new(p.clone(), Vec::new())
+                .map(Shape::Polygon)
+                .map_err(|e| (at.join("polygon"), e.to_string()))
+        }
+        None => geometry::Rectangle::new(r.origin, r.size)
+            .map(Shape::Rectangle)
+            .map_err(|e| (at.join("size"), e.to_string())),
+    }
+}
+
 /// Every zone's shape, checked one by one and then pairwise for overlaps.
 pub fn shapes(scene: &Scene) -> Result<Vec<Shape>, (FieldPath, String)> {
     let at = FieldPath::key("body").join("zones");
@@ -185,7 +205,14 @@ pub fn fill(scene: &Scene, width: usize) -> ParticleSet {
         return set;
     };
     let params = FillParams::new(scene.mesh.h, anchor(&scene.body.zones));
-    let Ok(points) = geometry::fill_zones(&shapes, &params) else {
+    let at = FieldPath::key("mesh").join("fine");
+    let fine: Vec<geometry::FineRegion> = (scene.mesh.fine.iter().enumerate())
+        .filter_map(|(i, r)| {
+            let shape = fine_region(r, &at.at(i)).ok()?;
+            Some(geometry::FineRegion { shape, h: r.h })
+        })
+        .collect();
+    let Ok(points) = geometry::fill_zones_graded(&shapes, &fine, &params) else {
         return set;
     };
     // A particle on the boundary of two zones belongs to the lower-indexed one (the fill's
