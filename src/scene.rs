@@ -171,6 +171,7 @@ impl Scene {
             ..SceneError::new(source, message)
         };
         gmsh_body::import(&mut scene, source).map_err(invalid)?;
+        zones::apply_within(&mut scene).map_err(invalid)?;
         scene.steps.count =
             validate_rigid::check_stages(&scene, scene.steps.count != 0).map_err(invalid)?;
         validate::validate(&scene).map_err(invalid)?;

@@ -623,3 +623,31 @@ fn a_layered_column_carries_the_weight_of_the_layers_above() {
         assert!(worst < 1e-10, "{what}: {worst:e}");
     }
 }
+
+/// A support selected by a `within` polygon (a thin band along the base, drawn slanted) holds
+/// what `on = "base"` holds: the base reaction is the plate's weight either way.
+#[test]
+fn a_polygon_selection_holds_what_the_named_edge_holds() {
+    let dir = workdir("plate-within");
+    let band = "within = [[-0.1, -0.05], [4.1, -0.05], [4.1, 0.02], [-0.1, 0.05]]";
+    let text = PLATE.replacen("on = \"base\"", band, 1);
+    assert_ne!(text, PLATE);
+    std::fs::write(dir.join("w.toml"), &text).unwrap();
+    ok(&dir, 1, &["new", "w.toml", "-o", "w.h5"]);
+    ok(&dir, 1, &["w.h5", "--out", "r"]);
+    std::fs::write(dir.join("o.toml"), PLATE).unwrap();
+    ok(&dir, 1, &["new", "o.toml", "-o", "o.h5"]);
+    ok(&dir, 1, &["o.h5", "--out", "ro"]);
+    let (_, within) = history(&dir.join("r/history.csv"));
+    let (_, on) = history(&dir.join("ro/history.csv"));
+    assert_eq!(within, on, "the same particles are held");
+    let far = text.replace(band, "within = [[10.0, 10.0], [11.0, 10.0], [11.0, 11.0]]");
+    std::fs::write(dir.join("far.toml"), far).unwrap();
+    let out = run(&dir, 1, &["new", "far.toml", "-o", "far.h5"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "a polygon selecting nothing was accepted"
+    );
+    assert!(err.contains("fixed[0].within"), "{err}");
+}

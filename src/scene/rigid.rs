@@ -120,13 +120,17 @@ pub struct SurfacePressure {
     #[serde(
         rename = "where",
         default = "Selector::all",
-        skip_serializing_if = "Selector::is_all"
+        skip_serializing_if = "Selector::has_no_conditions"
     )]
     pub region: Selector,
     /// `on = "crest"`: the boundary edges whose two ends started on the named boundary (a zone
     /// edge name or a Gmsh physical curve), and in `where` if given too.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub on: Option<String>,
+    /// `within = [[x, y], ...]`: only particles inside this polygon (edges included, within
+    /// 1e-9 of the body's size), e.g. a sloping face; with `where` and `on`, all must hold.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub within: Option<Vec<[f64; 2]>>,
     /// Pa.
     pub pressure: f64,
 }

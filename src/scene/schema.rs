@@ -459,13 +459,17 @@ pub struct Fixed {
     #[serde(
         rename = "where",
         default = "Selector::all",
-        skip_serializing_if = "Selector::is_all"
+        skip_serializing_if = "Selector::has_no_conditions"
     )]
     pub region: Selector,
     /// `on = "seabed"`: the particles on the zone edges of that name (`body.zones[].edges`),
     /// within 1e-6 mesh.h, and within `where` if given too.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub on: Option<String>,
+    /// `within = [[x, y], ...]`: only particles inside this polygon (edges included, within
+    /// 1e-9 of the body's size), e.g. a sloping face; with `where` and `on`, all must hold.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub within: Option<Vec<[f64; 2]>>,
     /// Constrained components, a non-empty subset of `["x", "y"]`.
     pub dofs: Vec<Dof>,
 }
@@ -492,12 +496,16 @@ pub struct Prescribed {
     #[serde(
         rename = "where",
         default = "Selector::all",
-        skip_serializing_if = "Selector::is_all"
+        skip_serializing_if = "Selector::has_no_conditions"
     )]
     pub region: Selector,
     /// As `fixed.on` (with `select = "initial"` only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub on: Option<String>,
+    /// As `fixed.within` (with `select = "initial"` only): only particles inside this polygon (edges included, within
+    /// 1e-9 of the body's size), e.g. a sloping face; with `where` and `on`, all must hold.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub within: Option<Vec<[f64; 2]>>,
     /// Prescribed components, a non-empty subset of `["x", "y"]`.
     pub dofs: Vec<Dof>,
     /// Displacement (m) reached at the end of loading, applied linearly over the steps. Only the

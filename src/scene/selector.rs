@@ -56,6 +56,9 @@ impl Condition {
 #[serde(try_from = "String", into = "String")]
 pub struct Selector {
     conditions: Vec<Condition>,
+    /// The entry's `within` polygon, when it has one: kept here so that every test of `where`
+    /// applies it too (it is written as its own key, not in the string).
+    polygon: Option<std::sync::Arc<[[f64; 2]]>>,
 }
 
 const SYNTAX_HELP: &str = "expected comparisons like \"x <= 1.5\" joined by \"and\" \
@@ -74,17 +77,35 @@ impl Selector {
                 }
             })?);
         }
-        Ok(Selector { conditions })
+        Ok(Selector {
+            conditions,
+            polygon: None,
+        })
     }
 
     /// Every point (a `where` left out).
     pub fn all() -> Self {
         Selector {
             conditions: Vec::new(),
+            polygon: None,
         }
     }
 
+    /// The same selection, also within the closed polygon `vertices` (a simple ring).
+    pub fn within(self, vertices: &[[f64; 2]]) -> Self {
+        Selector {
+            polygon: Some(vertices.into()),
+            ..self
+        }
+    }
+
+    /// Selects every point: no condition and no polygon.
     pub fn is_all(&self) -> bool {
+        self.conditions.is_empty() && self.polygon.is_none()
+    }
+
+    /// No `where` conditions (what the `where` string holds).
+    pub fn has_no_conditions(&self) -> bool {
         self.conditions.is_empty()
     }
 
@@ -95,6 +116,7 @@ impl Selector {
     /// True when `p` satisfies every condition (boundary slack `tol`).
     pub fn matches(&self, p: [f64; 2], tol: f64) -> bool {
         self.conditions.iter().all(|c| c.holds(p, tol))
+            && self.polygon.as_deref().is_none_or(|v| in_ring(v, p, tol))
     }
 
     /// The selected closed interval along `axis`, as `(lo, hi)` (infinite when unbounded).
@@ -201,5 +223,51 @@ mod tests {
             let e = Selector::parse(bad).unwrap_err();
             assert!(e.contains("expected comparisons"), "{bad}: {e}");
         }
+    }
+}
+
+/// Whether `p` lies inside the ring `v` or within `tol` of its edges (crossing number).
+fn in_ring(v: &[[f64; 2]], p: [f64; 2], tol: f64) -> bool {
+    let n = v.len();
+    let mut inside = false;
+    for k in 0..n {
+        let (a, b) = (v[k], v[(k + 1) % n]);
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len2 = dx * dx + dy * dy;
+        let t = if len2 > 0.0 {
+            (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let (qx, qy) = (a[0] + t * dx - p[0], a[1] + t * dy - p[1]);
+        if qx * qx + qy * qy <= tol * tol {
+            return true;
+        }
+        if (a[1] > p[1]) != (b[1] > p[1]) {
+            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * dx;
+            if p[0] < x {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
+
+#[cfg(test)]
+mod polygon_tests {
+    use super::*;
+
+    #[test]
+    fn a_polygon_selects_its_inside_and_its_edges() {
+        let tri = [[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]];
+        let s = Selector::all().within(&tri);
+        assert!(!s.is_all() && s.has_no_conditions());
+        assert!(s.matches([0.5, 0.5], 1e-9));
+        assert!(s.matches([1.0, 1.0], 1e-9), "on the slanted edge");
+        assert!(s.matches([0.0, 1.0], 1e-9) && s.matches([2.0, 0.0], 1e-9));
+        assert!(!s.matches([1.0, 1.0 + 1e-6], 1e-9));
+        assert!(!s.matches([-0.1, 0.5], 1e-9));
+        let both = Selector::parse("x >= 0.5").unwrap().within(&tri);
+        assert!(both.matches([0.6, 0.2], 1e-9) && !both.matches([0.4, 0.2], 1e-9));
     }
 }

@@ -432,7 +432,8 @@ fn check_selects_something(
     if region.is_all() && on.is_none() {
         return fail(
             entry.join("where"),
-            "is required (or `on`, naming a boundary): which particles?".to_string(),
+            "is required (or `on`, naming a boundary, or a `within` polygon): which particles?"
+                .to_string(),
         );
     }
     if let Some(name) = on {
@@ -457,12 +458,20 @@ fn check_selects_something(
     {
         return Ok(());
     }
-    let what = match (region.is_all(), on) {
-        (_, None) => format!("\"{region}\""),
+    let mut what = match (region.has_no_conditions(), on) {
+        (true, None) => "the `within` polygon".to_string(),
+        (false, None) => format!("\"{region}\""),
         (true, Some(n)) => format!("on = \"{n}\""),
         (false, Some(n)) => format!("\"{region}\" on \"{n}\""),
     };
-    let key = if region.is_all() { "on" } else { "where" };
+    if !region.is_all() && region.has_no_conditions() && on.is_some() {
+        what.push_str(" within its polygon");
+    }
+    let key = match (region.has_no_conditions(), on) {
+        (false, _) => "where",
+        (true, Some(_)) => "on",
+        (true, None) => "within",
+    };
     fail(
         entry.join(key),
         format!("{what} selects no particle of the body"),

@@ -339,3 +339,43 @@ pub fn area(scene: &Scene) -> f64 {
 pub fn deep_inside(shapes: &[Shape], p: [f64; 2], d: f64) -> bool {
     shapes.iter().any(|s| s.signed_distance(p) < -d)
 }
+
+/// Checks every `within` polygon of `[[fixed]]`, `[[prescribed]]` and `[[surface_pressure]]`
+/// and puts it into the entry's `where`, so that every test of the selection applies it.
+pub fn apply_within(scene: &mut Scene) -> Result<(), (FieldPath, String)> {
+    let check = |v: &[[f64; 2]], at: FieldPath| {
+        if let Some(k) = v.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
+            return Err((at, format!("vertex {k} is not finite")));
+        }
+        geometry::Polygon::new(v.to_vec(), Vec::new())
+            .map(|_| ())
+            .map_err(|e| (at, e.to_string()))
+    };
+    for (i, f) in scene.fixed.iter_mut().enumerate() {
+        if let Some(v) = &f.within {
+            check(v, FieldPath::key("fixed").at(i).join("within"))?;
+            f.region = f.region.clone().within(v);
+        }
+    }
+    for (i, p) in scene.prescribed.iter_mut().enumerate() {
+        if let Some(v) = &p.within {
+            let at = FieldPath::key("prescribed").at(i).join("within");
+            check(v, at.clone())?;
+            if p.select == super::schema::Selection::Current {
+                return Err((
+                    at,
+                    "selects by the body's initial shape, so it needs select = \"initial\""
+                        .to_string(),
+                ));
+            }
+            p.region = p.region.clone().within(v);
+        }
+    }
+    for (i, sp) in scene.surface_pressure.iter_mut().enumerate() {
+        if let Some(v) = &sp.within {
+            check(v, FieldPath::key("surface_pressure").at(i).join("within"))?;
+            sp.region = sp.region.clone().within(v);
+        }
+    }
+    Ok(())
+}
