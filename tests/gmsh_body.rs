@@ -142,7 +142,7 @@ fn a_site_meshed_in_gmsh_runs_from_its_nodes_and_physical_groups() {
             "{}: largest |σyy − weight above| / weight = {worst:.2e}",
             file.display()
         );
-        assert!(worst < 1e-9, "{worst:e}");
+        assert!(worst < 1e-12, "{worst:e}");
     }
     let (_, rows) = history(&dir.join("r/history.csv"));
     let uy = rows.last().unwrap()[1];
