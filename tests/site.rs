@@ -651,3 +651,64 @@ fn a_polygon_selection_holds_what_the_named_edge_holds() {
     );
     assert!(err.contains("fixed[0].within"), "{err}");
 }
+
+/// An elastic 1:2 slope from column weights: they are not in equilibrium, so the first step
+/// moves the crest; `equilibrate = true` first brings them into equilibrium, and the steps
+/// after it (no load changes) leave every particle where it was drawn.
+const SLOPE: &str = r#"
+name = "geostatic-slope"
+[body]
+zones = [{ name = "slope", polygon = [[0.0, 0.0], [20.0, 0.0], [20.0, 5.0], [10.0, 5.0]], edges = ["base", "far", "top", "face"] }]
+[mesh]
+h = 0.5
+[material]
+model = "linear-elastic"
+young = 2.0e7
+poisson = 0.3
+density = 2000.0
+[gravity]
+g = [0.0, -9.81]
+[geostatic]
+surface = 5.0
+k0 = 0.5
+[[fixed]]
+on = "base"
+dofs = ["x", "y"]
+[[fixed]]
+on = "far"
+dofs = ["x"]
+[[probe]]
+name = "crest"
+at = [10.0, 5.0]
+[steps]
+count = 2
+[history]
+columns = [{ name = "ux", measure = "probe.crest.ux" }, { name = "uy", measure = "probe.crest.uy" }]
+"#;
+
+#[test]
+fn an_equilibrated_geostatic_slope_stays_where_it_was_drawn() {
+    let dir = workdir("geostatic-slope");
+    let crest = |toml: &str, name: &str| {
+        std::fs::write(dir.join(format!("{name}.toml")), toml).unwrap();
+        ok(
+            &dir,
+            1,
+            &["new", &format!("{name}.toml"), "-o", &format!("{name}.h5")],
+        );
+        let out = ok(&dir, 2, &[&format!("{name}.h5"), "--out", name]);
+        let (_, rows) = history(&dir.join(name).join("history.csv"));
+        let last = rows.last().unwrap();
+        (last[1].hypot(last[2]), out)
+    };
+    let (moved, _) = crest(SLOPE, "columns");
+    let text = SLOPE.replace("k0 = 0.5", "k0 = 0.5\nequilibrate = true");
+    let (stays, out) = crest(&text, "equilibrated");
+    println!("crest moves {moved:.3e} m from column weights, {stays:.3e} m equilibrated");
+    assert!(out.contains("geostatic: equilibrated"), "{out}");
+    assert!(
+        moved > 1e-4,
+        "the column stresses must be out of equilibrium: {moved}"
+    );
+    assert!(stays < 1e-9 * moved, "{stays} against {moved}");
+}

@@ -4,6 +4,7 @@ mod adapt;
 mod boundary_rules;
 mod contact;
 mod error;
+mod geostatic;
 mod node_values;
 mod output;
 mod progress;
@@ -87,6 +88,16 @@ fn drive(
     let mut sizes = None;
     let mut solve_cpu = 0.0;
     let mut collapse = None;
+    let equilibrate = sim.model.scene.geostatic.is_some_and(|g| g.equilibrate);
+    if sim.step() == 0 && equilibrate {
+        let (newton, left) = sim.equilibrate_geostatic(world, petsc)?;
+        if rank == 0 {
+            println!(
+                "geostatic: equilibrated in {newton} Newton iterations (last pass moved \
+                 {left:.1e} of the first)"
+            );
+        }
+    }
     while sim.step() < last {
         let mut t = PhaseTimer::default();
         let next = sim.step() + 1;

@@ -132,11 +132,11 @@ pub struct Solved {
     /// Load-factor increment solved for.
     dlambda: f64,
     dofs: DofMap,
-    du: Vec<[f64; 2]>,
+    pub(super) du: Vec<[f64; 2]>,
     /// Pressure of every local node (NaN without a pressure unknown).
     pressure: Vec<f64>,
     /// Per local triangle, its Gauss points' rows of the material's layout.
-    states: Rows,
+    pub(super) states: Rows,
     reaction: [f64; 2],
     /// Reaction on each `[[fixed]]`, then `[[prescribed]]` entry (named ones; others zero).
     set_reactions: Vec<[f64; 2]>,
@@ -144,7 +144,7 @@ pub struct Solved {
     body_force: Vec<[f64; 2]>,
     /// Pressure and shear of every contact node at the solution.
     contact_state: super::contact::ContactState,
-    newton_iterations: usize,
+    pub(super) newton_iterations: usize,
     /// Krylov iterations of the increment's linear solves (1 per Newton iteration when direct).
     linear_iterations: usize,
     residual_norm: f64,

@@ -148,6 +148,13 @@ pub struct Geostatic {
     /// Coefficient of earth pressure at rest, default 1.
     #[serde(default = "one")]
     pub k0: f64,
+    /// Bring the column stresses into equilibrium with gravity, the supports and the surface
+    /// pressures before step 1, as Abaqus' geostatic step does: Newton solves at the starting
+    /// load factor whose stresses are kept and whose displacements are dropped (the particles
+    /// stay where they were drawn). Needed on sloping ground, where column weights are not in
+    /// equilibrium. Default false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub equilibrate: bool,
 }
 
 fn one() -> f64 {
