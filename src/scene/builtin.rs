@@ -21,6 +21,10 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "footing-layered",
         include_str!("builtin/footing-layered.toml"),
     ),
+    (
+        "footing-gradient",
+        include_str!("builtin/footing-gradient.toml"),
+    ),
 ];
 
 /// TOML text of the built-in scene `name`.
