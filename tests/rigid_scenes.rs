@@ -101,12 +101,12 @@ fn tbar(name: &str, exact: f64) {
 }
 
 #[test]
-fn tbar_smooth_coarse_reaches_the_exact_nc() {
+fn tbar_smooth_coarse_is_within_8_percent_of_the_exact_nc() {
     tbar("tbar-smooth", 9.142);
 }
 
 #[test]
-fn tbar_rough_coarse_reaches_the_exact_nc() {
+fn tbar_rough_coarse_is_within_8_percent_of_the_exact_nc() {
     tbar("tbar-rough", 11.940);
 }
 
