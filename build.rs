@@ -5,9 +5,25 @@
 use std::env;
 use std::path::PathBuf;
 
+#[path = "build/scene_reference.rs"]
+mod scene_reference;
+
 fn main() {
     println!("cargo:rerun-if-changed=src/petsc/wrapper.h");
     println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed=build/scene_reference.rs");
+    let out_dir = PathBuf::from(env::var("OUT_DIR").expect("OUT_DIR"));
+    let sources: Vec<String> = scene_reference::SOURCES
+        .iter()
+        .map(|p| {
+            println!("cargo:rerun-if-changed={p}");
+            std::fs::read_to_string(p).unwrap_or_else(|e| panic!("cannot read {p}: {e}"))
+        })
+        .collect();
+    let reference = scene_reference::generate(&sources)
+        .unwrap_or_else(|e| panic!("scene reference: the schema does not parse: {e}"));
+    std::fs::write(out_dir.join("scene_reference.md"), reference)
+        .expect("could not write the scene reference");
     let petsc = pkg_config::Config::new().probe("PETSc").expect(
         "PETSc not found by pkg-config: install the native stack (README, `.ci/install-native`)",
     );

@@ -8,6 +8,7 @@ usage:
   pfem-mpi info FILE.h5                                             summarise a case or checkpoint
   pfem-mpi mesh FILE.h5                                             mesh it once, print its fingerprint
   pfem-mpi plot DIR                                                 draw DIR/plots/*.png from a run's output
+  pfem-mpi schema                                                   print the scene reference (Markdown)
   mpirun -n N pfem-mpi FILE.h5 [--out DIR] [--until-step K] [-- PETSc options]
                                                                     run (or continue) an analysis
 built-in scenes:";
@@ -39,6 +40,8 @@ pub enum Command {
         until_step: Option<u64>,
         petsc: Vec<String>,
     },
+    /// Print the scene reference generated from the schema.
+    Schema,
     Help,
     Version,
 }
@@ -53,6 +56,10 @@ pub fn parse(args: &[String]) -> Result<Command, String> {
     match first.as_str() {
         "-h" | "--help" | "help" => Ok(Command::Help),
         "-V" | "--version" => Ok(Command::Version),
+        "schema" => match &ours[1..] {
+            [] => Ok(Command::Schema),
+            _ => Err("schema: takes no arguments".into()),
+        },
         "new" => {
             let mut scene = None;
             let mut out = None;

@@ -55,7 +55,7 @@ pub fn execute(command: Command) -> i32 {
                 Err(e) => Err(e.into()),
             }
         }
-        Command::Help | Command::Version => Ok(()),
+        Command::Help | Command::Version | Command::Schema => Ok(()),
     };
     match crate::run::agree_or_abort(&errors, local) {
         Ok(()) => 0,

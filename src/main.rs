@@ -35,6 +35,7 @@ fn main() {
     match command {
         Command::Help => println!("{}", cli::usage()),
         Command::Version => println!("pfem-mpi {}", env!("CARGO_PKG_VERSION")),
+        Command::Schema => print!("{}", pfem_mpi::scene::REFERENCE),
         other => std::process::exit(commands::execute(other)),
     }
 }

@@ -205,6 +205,11 @@ impl Scene {
     }
 }
 
+/// The scene reference (every table and key, from the schema's doc comments), generated at
+/// build time by `build/scene_reference.rs`; `pfem-mpi schema` prints it and
+/// `docs/guide/scene-reference.md` is its committed copy.
+pub const REFERENCE: &str = include_str!(concat!(env!("OUT_DIR"), "/scene_reference.md"));
+
 /// The file [`load_scene`] reads for `name_or_path`, or `None` when it names a built-in (or
 /// nothing).
 pub fn scene_file(name_or_path: &str) -> Option<&Path> {

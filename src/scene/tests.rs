@@ -483,3 +483,24 @@ fn mesh_adapt_defaults_round_trip_and_bad_values_name_the_field() {
         "{e}"
     );
 }
+
+/// The committed scene reference is what the schema generates (regenerate with `pfem-mpi schema >
+/// docs/guide/scene-reference.md`).
+#[test]
+fn the_committed_scene_reference_is_up_to_date() {
+    let committed = include_str!("../../docs/guide/scene-reference.md");
+    assert!(
+        committed == super::REFERENCE,
+        "docs/guide/scene-reference.md differs from the schema: regenerate it with \
+         `pfem-mpi schema > docs/guide/scene-reference.md`"
+    );
+    for key in [
+        "`[[body.zones]]`",
+        "`mesh`",
+        "`within`",
+        "`equilibrate`",
+        "`cu_gradient`",
+    ] {
+        assert!(committed.contains(key), "{key} is missing");
+    }
+}
