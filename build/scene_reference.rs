@@ -114,8 +114,10 @@ fn renamed(ident: &str, rule: Option<&str>) -> String {
     }
 }
 
+type Items = (HashMap<String, Struct>, HashMap<String, Enum>);
+
 /// Every deserialised struct and enum of the sources, by type name.
-fn collect(sources: &[String]) -> Result<(HashMap<String, Struct>, HashMap<String, Enum>), String> {
+fn collect(sources: &[String]) -> Result<Items, String> {
     let (mut structs, mut enums) = (HashMap::new(), HashMap::new());
     for text in sources {
         let file = syn::parse_file(text).map_err(|e| e.to_string())?;
