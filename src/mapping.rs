@@ -326,6 +326,65 @@ mod tests {
     }
 
     #[test]
+    fn states_of_two_materials_travel_each_within_its_own() {
+        // Material 0 left of x = 1/2 (its points on the line too), 1 right; a state of 1 in
+        // material 0 and 2 in material 1, whose jump mesh b's other diagonals must not smear.
+        let (a, b) = meshes(6, 1.0 / 6.0);
+        let point = |m: &LocalMesh| -> Vec<u32> {
+            m.points
+                .iter()
+                .map(|p| u32::from(p[0] > 0.5 + 1e-9))
+                .collect()
+        };
+        let tri = |m: &LocalMesh| -> Vec<u32> {
+            m.tris
+                .iter()
+                .map(|t| {
+                    let x = t.iter().map(|&v| m.points[v as usize][0]).sum::<f64>() / 3.0;
+                    u32::from(x > 0.5)
+                })
+                .collect()
+        };
+        let (tri_a, point_a, tri_b, point_b) = (tri(&a), point(&a), tri(&b), point(&b));
+        let mut states = Rows::new(POINTS * K);
+        for &m in &tri_a {
+            states.push(&[1.0 + f64::from(m); POINTS * K]);
+        }
+        let with = |tri, point| Some(MeshMaterials { tri, point });
+        let recovered = recover_at_particles(
+            &a,
+            &states,
+            &Rows::zeros(K, a.n_owned),
+            with(&tri_a, &point_a),
+        );
+        for (p, &m) in point_a.iter().enumerate() {
+            for x in recovered.row(p) {
+                assert!(
+                    (x - (1.0 + f64::from(m))).abs() < 1e-14,
+                    "{x} at material {m}"
+                );
+            }
+        }
+        let on_b = recovered.slice(0..b.points.len());
+        let (mapped, _) = map_states(&TriStates::default(), &b, &on_b, with(&tri_b, &point_b));
+        for (row, &m) in mapped.iter().zip(&tri_b) {
+            for x in row {
+                assert!(
+                    (x - (1.0 + f64::from(m))).abs() < 1e-15,
+                    "{x} in material {m}"
+                );
+            }
+        }
+        // Without the materials, the particles on the interface carry the mean of both.
+        let mixed = recover_at_particles(&a, &states, &Rows::zeros(K, a.n_owned), None);
+        let on_line = (0..a.n_owned).find(|&p| {
+            (a.points[p][0] - 0.5).abs() < 1e-9 && a.points[p][1] > 0.1 && a.points[p][1] < 0.9
+        });
+        let on_line = on_line.expect("an interior point on the interface");
+        assert!((mixed.row(on_line)[0] - 1.5).abs() < 1e-12);
+    }
+
+    #[test]
     fn unchanged_triangles_keep_their_states() {
         let (a, _) = meshes(4, 0.25);
         let states = states_of(&a, &|p| p[0] * p[0]);
