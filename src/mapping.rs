@@ -14,18 +14,6 @@ use crate::mesh::LocalMesh;
 /// Gauss points per triangle: a triangle's state row holds this many rows of the layout.
 pub const POINTS: usize = 3;
 
-/// The materials of a mesh of several: each triangle's and each point's (a row per
-/// `mesh.points` entry). The states of two materials differ at their interface (there the
-/// exact stress jumps, as the pressure of the mixed element may), so a transfer that averaged
-/// across it would put each side's state into the triangles of the other: two Tresca zones
-/// under a platen, remeshed twice near the end of the squeeze, carried the mixture into the
-/// platen force at 1e-5. So values travel within a material where they can.
-#[derive(Debug, Clone, Copy)]
-pub struct MeshMaterials<'a> {
-    pub tri: &'a [u32],
-    pub point: &'a [u32],
-}
-
 /// The start-of-step Gauss states of every local triangle, as the step reads them: one row of
 /// [`POINTS`] layout rows per triangle. An elastic law's layout is the stress alone, so its
 /// states cost no more than the stress.
@@ -130,19 +118,12 @@ pub struct MapStats {
 
 /// States for `mesh`'s triangles: kept where the triangle existed before (same three global
 /// ids), otherwise interpolated linearly from the particle values `at_points` (a row per
-/// `mesh.points` entry); with `materials`, from those of its vertices that are of the
-/// triangle's material (their area coordinates rescaled to sum to one), or all where none is.
-/// Both inputs are bitwise identical on every rank that holds the triangle
+/// `mesh.points` entry). Both inputs are bitwise identical on every rank that holds the triangle
 /// (the particle values travel with the halo), so every copy of an interface triangle gets the
 /// same states. (Interpolating from the old triangle that contains a new Gauss point would smooth
 /// less, but a rank does not hold every old triangle around its ghost triangles, so copies could
 /// differ.)
-pub fn map_states(
-    old: &TriStates,
-    mesh: &LocalMesh,
-    at_points: &Rows,
-    materials: Option<MeshMaterials>,
-) -> (Rows, MapStats) {
+pub fn map_states(old: &TriStates, mesh: &LocalMesh, at_points: &Rows) -> (Rows, MapStats) {
     let w = at_points.width();
     let mut stats = MapStats::default();
     let mut states = Rows::with_capacity(POINTS * w, mesh.tris.len());
@@ -158,22 +139,8 @@ pub fn map_states(
         let tri = mesh.tris[t];
         let v = tri.map(|i| mesh.points[i as usize]);
         let vals = tri.map(|i| at_points.row(i as usize));
-        let own = materials.map_or([true; 3], |m| {
-            let own = tri.map(|i| m.point[i as usize] == m.tri[t]);
-            if own.contains(&true) {
-                own
-            } else {
-                [true; 3]
-            }
-        });
         for (q, p) in p2_gauss_points(&straight_sided(&v)).iter().enumerate() {
-            let mut bary = barycentric(v[0], v[1], v[2], *p);
-            if own != [true; 3] {
-                let kept: f64 = (0..3).filter(|&k| own[k]).map(|k| bary[k]).sum();
-                for k in 0..3 {
-                    bary[k] = if own[k] { bary[k] / kept } else { 0.0 };
-                }
-            }
+            let bary = barycentric(v[0], v[1], v[2], *p);
             let out = &mut row[q * w..(q + 1) * w];
             out.fill(0.0);
             for (l, vk) in bary.iter().zip(&vals) {
@@ -188,49 +155,32 @@ pub fn map_states(
 }
 
 /// Particle values of the Gauss states: each triangle's linear extrapolation to its vertices,
-/// averaged over the triangles around an owned particle with their areas as weights; with
-/// `materials`, over those of the particle's material where it has any. Owned particles in no
-/// triangle keep `previous`.
-pub fn recover_at_particles(
-    mesh: &LocalMesh,
-    states: &Rows,
-    previous: &Rows,
-    materials: Option<MeshMaterials>,
-) -> Rows {
+/// averaged over the triangles around an owned particle with their areas as weights. Owned
+/// particles in no triangle keep `previous`.
+pub fn recover_at_particles(mesh: &LocalMesh, states: &Rows, previous: &Rows) -> Rows {
     let n = mesh.n_owned;
     let w = previous.width();
     let mut sum = Rows::zeros(w, n);
     let mut weight = vec![0.0; n];
     let mut at_vertex = vec![0.0; w];
-    let mut accumulate = |select: &dyn Fn(usize, usize) -> bool, weight: &mut [f64]| {
-        for (t, (tri, s)) in mesh.tris.iter().zip(states.iter()).enumerate() {
-            let [a, b, c] = tri.map(|v| mesh.points[v as usize]);
-            let area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
-            for (k, &v) in tri.iter().enumerate() {
-                let v = v as usize;
-                if v >= n || !select(t, v) {
-                    continue;
-                }
-                at_vertex.fill(0.0);
-                for (q, coeff) in GAUSS_TO_VERTEX[k].iter().enumerate() {
-                    for (o, g) in at_vertex.iter_mut().zip(&s[q * w..(q + 1) * w]) {
-                        *o += coeff * g;
-                    }
-                }
-                weight[v] += area;
-                for (acc, x) in sum.row_mut(v).iter_mut().zip(&at_vertex) {
-                    *acc += area * x;
+    for (tri, s) in mesh.tris.iter().zip(states.iter()) {
+        let [a, b, c] = tri.map(|v| mesh.points[v as usize]);
+        let area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+        for (k, &v) in tri.iter().enumerate() {
+            let v = v as usize;
+            if v >= n {
+                continue;
+            }
+            at_vertex.fill(0.0);
+            for (q, coeff) in GAUSS_TO_VERTEX[k].iter().enumerate() {
+                for (o, g) in at_vertex.iter_mut().zip(&s[q * w..(q + 1) * w]) {
+                    *o += coeff * g;
                 }
             }
-        }
-    };
-    match materials {
-        None => accumulate(&|_, _| true, &mut weight),
-        Some(m) => {
-            accumulate(&|t, v| m.tri[t] == m.point[v], &mut weight);
-            // A particle with no triangle of its material around it takes all of them.
-            let bare: Vec<bool> = weight.iter().map(|&wt| wt == 0.0).collect();
-            accumulate(&|_, v| bare[v], &mut weight);
+            weight[v] += area;
+            for (acc, x) in sum.row_mut(v).iter_mut().zip(&at_vertex) {
+                *acc += area * x;
+            }
         }
     }
     for (i, &wt) in weight.iter().enumerate() {
@@ -294,11 +244,10 @@ mod tests {
     fn round_trip_error(n: usize, f: impl Fn([f64; 2]) -> f64) -> f64 {
         let h = 1.0 / n as f64;
         let (a, b) = meshes(n, h);
-        let at_particles =
-            recover_at_particles(&a, &states_of(&a, &f), &Rows::zeros(K, a.n_owned), None);
+        let at_particles = recover_at_particles(&a, &states_of(&a, &f), &Rows::zeros(K, a.n_owned));
         // Mesh b numbers the same points in reverse: its particle values are a's, reversed.
         let on_b = at_particles.slice(0..b.points.len());
-        let (mapped, stats) = map_states(&TriStates::default(), &b, &on_b, None);
+        let (mapped, stats) = map_states(&TriStates::default(), &b, &on_b);
         assert_eq!(stats.kept, 0);
         let exact = states_of(&b, &f);
         let mut worst: f64 = 0.0;
@@ -326,70 +275,11 @@ mod tests {
     }
 
     #[test]
-    fn states_of_two_materials_travel_each_within_its_own() {
-        // Material 0 left of x = 1/2 (its points on the line too), 1 right; a state of 1 in
-        // material 0 and 2 in material 1, whose jump mesh b's other diagonals must not smear.
-        let (a, b) = meshes(6, 1.0 / 6.0);
-        let point = |m: &LocalMesh| -> Vec<u32> {
-            m.points
-                .iter()
-                .map(|p| u32::from(p[0] > 0.5 + 1e-9))
-                .collect()
-        };
-        let tri = |m: &LocalMesh| -> Vec<u32> {
-            m.tris
-                .iter()
-                .map(|t| {
-                    let x = t.iter().map(|&v| m.points[v as usize][0]).sum::<f64>() / 3.0;
-                    u32::from(x > 0.5)
-                })
-                .collect()
-        };
-        let (tri_a, point_a, tri_b, point_b) = (tri(&a), point(&a), tri(&b), point(&b));
-        let mut states = Rows::new(POINTS * K);
-        for &m in &tri_a {
-            states.push(&[1.0 + f64::from(m); POINTS * K]);
-        }
-        let with = |tri, point| Some(MeshMaterials { tri, point });
-        let recovered = recover_at_particles(
-            &a,
-            &states,
-            &Rows::zeros(K, a.n_owned),
-            with(&tri_a, &point_a),
-        );
-        for (p, &m) in point_a.iter().enumerate() {
-            for x in recovered.row(p) {
-                assert!(
-                    (x - (1.0 + f64::from(m))).abs() < 1e-14,
-                    "{x} at material {m}"
-                );
-            }
-        }
-        let on_b = recovered.slice(0..b.points.len());
-        let (mapped, _) = map_states(&TriStates::default(), &b, &on_b, with(&tri_b, &point_b));
-        for (row, &m) in mapped.iter().zip(&tri_b) {
-            for x in row {
-                assert!(
-                    (x - (1.0 + f64::from(m))).abs() < 1e-15,
-                    "{x} in material {m}"
-                );
-            }
-        }
-        // Without the materials, the particles on the interface carry the mean of both.
-        let mixed = recover_at_particles(&a, &states, &Rows::zeros(K, a.n_owned), None);
-        let on_line = (0..a.n_owned).find(|&p| {
-            (a.points[p][0] - 0.5).abs() < 1e-9 && a.points[p][1] > 0.1 && a.points[p][1] < 0.9
-        });
-        let on_line = on_line.expect("an interior point on the interface");
-        assert!((mixed.row(on_line)[0] - 1.5).abs() < 1e-12);
-    }
-
-    #[test]
     fn unchanged_triangles_keep_their_states() {
         let (a, _) = meshes(4, 0.25);
         let states = states_of(&a, &|p| p[0] * p[0]);
         let old = TriStates::new(&a, states.clone());
-        let (mapped, stats) = map_states(&old, &a, &Rows::zeros(K, a.points.len()), None);
+        let (mapped, stats) = map_states(&old, &a, &Rows::zeros(K, a.points.len()));
         assert_eq!(stats.interpolated, 0);
         assert_eq!(mapped, states);
     }

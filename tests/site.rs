@@ -317,9 +317,11 @@ fn bad_zones_are_refused_with_the_field_named() {
 /// Two Tresca zones side by side, soft (cu = 10 kPa) left and stiff (cu = 20 kPa) right,
 /// squeezed between smooth platens by 10 %. Newton is run to 1e-12 relative: the first
 /// increment takes the soft zone from rest past yield, and the default 1e-9 left it at a residual
-/// of 6e-6 N (iteration 18; the 19th reaches 5e-11) whose non-uniform error the perfectly
-/// plastic flow of the later increments amplified into the platen force at 1.3e-6 (measured
-/// step by step: 2e-10 at step 5, 1.5e-7 at step 8); at 1e-12 it ends at 4.6e-10.
+/// of 6e-6 N (iteration 18; the 19th reaches 5e-11). The block was then a little non-uniform,
+/// which the perfectly plastic flow of the later increments amplified (platen force off by 2e-10
+/// at step 5, 1.5e-7 at step 8) until the remesh flipped cells of the square lattice at steps 9
+/// and 10 and mapped states across the interface: 1.0e-5 at the end. At 1e-12 the block stays
+/// uniform, no triangle is remapped, and the force ends 4.6e-10 off.
 const TWO_ZONES: &str = r#"
 name = "two-zones"
 [body]
@@ -423,8 +425,7 @@ fn zones_of_two_materials_carry_their_own_strengths() {
     println!("platen force {got}, 2 cu w summed over the zones {want}");
     // The pressure jumps from p = cu_soft to p = cu_stiff across the interface: a continuous
     // P1 pressure smeared it over the triangles beside it, off the yield surfaces (0.8 % above
-    // at h = 0.1). With a pressure per material at the interface vertices, and states carried
-    // within a material when the remesh makes new triangles there, measured 4.6e-10.
+    // at h = 0.1). With a pressure per material at the interface vertices: 4.6e-10.
     assert!(
         (got - want).abs() <= 1e-6 * want.abs(),
         "{got} against {want}"

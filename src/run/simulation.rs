@@ -3,7 +3,7 @@
 use super::RunError;
 use crate::case_file::{read_checkpoint, CaseHeader};
 use crate::history::Measures;
-use crate::mapping::{map_states, MeshMaterials, StartStates, TriStates};
+use crate::mapping::{map_states, StartStates, TriStates};
 use crate::mesh::local::halo_width;
 use crate::mesh::LocalMesh;
 use crate::model::Model;
@@ -236,15 +236,7 @@ impl Simulation {
         if self.model.scene.mesh.remap_all {
             old = TriStates::default();
         }
-        let materials = self.mesh_materials(mesh);
-        let (states, stats) = map_states(
-            &old,
-            mesh,
-            &at_points,
-            materials
-                .as_ref()
-                .map(|(tri, point)| MeshMaterials { tri, point }),
-        );
+        let (states, stats) = map_states(&old, mesh, &at_points);
         drop(old);
         self.remapped
             .set(self.remapped.get() + stats.interpolated_owned as u64);

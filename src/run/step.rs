@@ -2,7 +2,7 @@
 //! then moving the particles and carrying the new Gauss states to them.
 
 use super::{Simulation, StepReport};
-use crate::mapping::{recover_at_particles, MeshMaterials, StartStates, TriStates};
+use crate::mapping::{recover_at_particles, StartStates, TriStates};
 use crate::material::Rows;
 use crate::mesh::LocalMesh;
 use crate::petsc::linear::{p_multigrid_from_options, upper_triangle_smoother_from_options};
@@ -244,18 +244,6 @@ impl Simulation {
                 }
             })
             .collect()
-    }
-
-    /// Where the scene has several materials, those of `mesh`'s triangles and points, which
-    /// keep the state transfer within a material ([`MeshMaterials`]).
-    pub(super) fn mesh_materials(&self, mesh: &LocalMesh) -> Option<(Vec<u32>, Vec<u32>)> {
-        if self.model.materials.len() == 1 {
-            return None;
-        }
-        let point = (0..mesh.points.len())
-            .map(|p| self.point_material(mesh, p))
-            .collect();
-        Some((self.triangle_materials(mesh), point))
     }
 
     /// The material index of mesh point `p` (owned or ghost).
@@ -846,15 +834,7 @@ impl Simulation {
         *self.last_nodes.borrow_mut() =
             super::node_values::NodeValues::new(last, self.model.mixed())
                 .with_material_pressures(by_material);
-        let materials = self.mesh_materials(mesh);
-        self.particles.state = recover_at_particles(
-            mesh,
-            &solved.states,
-            &self.particles.state,
-            materials
-                .as_ref()
-                .map(|(tri, point)| MeshMaterials { tri, point }),
-        );
+        self.particles.state = recover_at_particles(mesh, &solved.states, &self.particles.state);
         self.tri_states = TriStates::new(mesh, solved.states);
         self.last_reaction = solved.reaction;
         self.last_set_reactions = solved.set_reactions;
