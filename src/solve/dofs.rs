@@ -3,7 +3,9 @@
 //! endpoint, which always holds every triangle around that edge. Owned dofs are numbered
 //! contiguously per rank (offsets by exclusive scan); ghost numbers are fetched from their owners.
 
-use super::material_pressures::{pressure_key, MaterialPressures, Pressure};
+use super::material_pressures::{
+    number_material_pressures, MaterialPressures, NodeTables, Pressure,
+};
 use crate::mesh::LocalMesh;
 use pfem_partition::{exscan_u64, fetch_pairs, Comm, PartitionError};
 use std::collections::HashMap;
@@ -443,134 +445,16 @@ impl DofMap {
         }
     }
 
-    /// [`Self::preallocation`] where pressures are per material: a displacement row couples to
-    /// every dof of the triangles around its node, a pressure row only to those of the triangles
-    /// of its material, which the node counts of the continuous case would overestimate.
-    fn preallocation_by_dof(&self) -> (Vec<usize>, Vec<usize>) {
-        let n_local = self.n_local_dofs();
-        let element_dofs = 12 + 3 * usize::from(self.vertex_dofs == 3);
-        let mut owned_local = vec![false; n_local];
-        for n in (0..self.n_nodes()).filter(|&n| self.node_owned[n]) {
-            let o = self.node_local(n);
-            owned_local[o..o + self.ndof(n)].fill(true);
-        }
-        // Columns (local dofs) of each row group: a node's two displacement rows share its
-        // x row's.
-        let mut cols: Vec<Vec<u32>> = vec![Vec::new(); n_local];
-        let mut local = [0u32; 15];
-        for t in 0..self.tri_nodes.len() {
-            for (k, l) in local[..element_dofs].iter_mut().enumerate() {
-                let (node, c) = self.element_dof(t, k);
-                *l = (self.node_local(node) + c) as u32;
-            }
-            for k in 0..element_dofs {
-                let (node, c) = self.element_dof(t, k);
-                if self.node_owned[node] && c != 1 {
-                    cols[local[k] as usize].extend_from_slice(&local[..element_dofs]);
-                }
-            }
-        }
-        let mut d = vec![0; self.n_owned_dofs];
-        let mut o = vec![0; self.n_owned_dofs];
-        for n in (0..self.n_nodes()).filter(|&n| self.node_owned[n]) {
-            let row = self.node_global[n] - self.first_dof;
-            for c in 0..self.ndof(n) {
-                let group = &mut cols[self.node_local(n) + if c < 2 { 0 } else { c }];
-                group.sort_unstable();
-                group.dedup();
-                let owned = group.iter().filter(|&&j| owned_local[j as usize]).count();
-                d[row + c] = owned;
-                o[row + c] = group.len() - owned;
-            }
-        }
-        (d, o)
-    }
-
     /// Per owned pressure unknown, in the order of their dofs: how many pressure unknowns
     /// (itself included) share a triangle with it, owned by this rank and by others: the pattern
     /// of the P1 pressure mass matrix, which couples a material's pressures only among its own
     /// triangles.
     pub fn pressure_neighbour_counts(&self) -> Vec<(usize, usize)> {
-        if self.material_pressures.is_none() {
-            return self.vertex_neighbour_counts();
+        if self.material_pressures.is_some() {
+            return self.material_pressure_neighbour_counts();
         }
-        let n_vertex = self.n_nodes() - self.edges.len();
-        let mut node_of = vec![0usize; self.n_pressure_unknowns()];
-        for n in 0..n_vertex {
-            for c in 2..self.ndof(n) {
-                node_of[self.pressure_unknown(n, c)] = n;
-            }
-        }
-        let mut cols: Vec<Vec<usize>> = vec![Vec::new(); node_of.len()];
-        for (t, nodes) in self.tri_nodes.iter().enumerate() {
-            let u: [usize; 3] = std::array::from_fn(|k| {
-                self.pressure_unknown(nodes[k] as usize, self.pressure_component(t, k))
-            });
-            for &r in &u {
-                if self.node_owned[node_of[r]] {
-                    cols[r].extend_from_slice(&u);
-                }
-            }
-        }
-        (0..node_of.len())
-            .filter(|&r| self.node_owned[node_of[r]])
-            .map(|r| {
-                let c = &mut cols[r];
-                c.sort_unstable();
-                c.dedup();
-                let owned = c.iter().filter(|&&j| self.node_owned[node_of[j]]).count();
-                (owned, c.len() - owned)
-            })
-            .collect()
+        self.vertex_neighbour_counts()
     }
-}
-
-/// The vertex nodes' points and every node's owner flag and first global dof, as `build` made
-/// them.
-struct NodeTables<'a> {
-    point: &'a [u32],
-    owned: &'a [bool],
-    global: &'a [usize],
-}
-
-/// Collective. Numbers the pressures of `mp`: an owned vertex's follow its displacements, by
-/// material; a ghost's are asked of the vertex's owner by (gid, material), since a ghost may lack
-/// some of the materials around the vertex.
-fn number_material_pressures(
-    comm: &Comm,
-    mesh: &LocalMesh,
-    nodes: NodeTables,
-    mp: &mut MaterialPressures,
-) -> Result<(), PartitionError> {
-    let mut owned_number: HashMap<[u64; 2], u64> = HashMap::new();
-    let mut requests = Vec::new();
-    let mut asked = Vec::new();
-    for (n, &p) in nodes.point.iter().enumerate() {
-        let p = p as usize;
-        for slot in 0..mp.count(n) {
-            let key = pressure_key(mesh.gids[p], mp.material(n, slot));
-            if nodes.owned[n] {
-                let g = nodes.global[n] + 2 + slot;
-                mp.set_global(n, slot, g);
-                owned_number.insert(key, g as u64);
-            } else {
-                requests.push((mesh.owner[p], key));
-                asked.push((n, slot));
-            }
-        }
-    }
-    let answers = fetch_pairs(comm, &requests, |k| {
-        owned_number.get(k).copied().ok_or_else(|| {
-            PartitionError::InvalidInput(format!(
-                "pressure {k:?} asked for by another rank is not on its owner: the ranks \
-                 disagree on a triangle's material, or the halo is too narrow"
-            ))
-        })
-    })?;
-    for ((n, slot), g) in asked.into_iter().zip(answers) {
-        mp.set_global(n, slot, g as usize);
-    }
-    Ok(())
 }
 
 #[cfg(test)]
