@@ -625,7 +625,8 @@ impl Simulation {
         let state = |p: usize| self.point_state(mesh, p);
         // Where pressures are per material, a vertex's pressure in a material it did not touch
         // in the last increment (or after a restart, whose checkpoint keeps one pressure per
-        // vertex) starts from its pressure in the other: a value of the solution all the same.
+        // vertex) starts from its pressure in its lowest material there: a value of the last
+        // solution all the same, nearer than the particle's recovered mean.
         let displacement = |n: usize| {
             if let Some(v) = last.get(&node_key(mesh, dofs, n)) {
                 return [scale * v[0], scale * v[1]];
