@@ -9,6 +9,7 @@ use crate::rigid::RigidBody;
 use crate::scene::{Axis, ElementChoice, Fixed, MaterialModel, Prescribed, Scene, Selection};
 use crate::solve::Kernel;
 use crate::solve::Law;
+use crate::solve::Pressure;
 
 /// The internal variables of a scene material's model. They depend on the model alone (not on
 /// its parameters' values), so they are known before the parameters are checked.
@@ -185,6 +186,19 @@ impl Model {
 
     pub fn mixed(&self) -> bool {
         matches!(self.kernel, Kernel::P2P1 { .. })
+    }
+
+    /// The pressure unknowns of the element on a mesh whose triangles have the materials
+    /// `tri_material`: one per vertex and material of the triangles around it where the scene
+    /// has several materials, so that the pressure may jump across their interfaces.
+    pub fn pressure<'a>(&self, tri_material: &'a [u32]) -> Pressure<'a> {
+        if !self.mixed() {
+            Pressure::None
+        } else if self.materials.len() > 1 {
+            Pressure::PerMaterial(tri_material)
+        } else {
+            Pressure::Continuous
+        }
     }
 
     /// The body force of material `material` at load factor `lambda`: `density * g`, scaled by

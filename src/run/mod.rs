@@ -138,10 +138,11 @@ fn drive(
         progress.step(sim, &report, &t);
         // Measured once, on the last mesh: the same condition on every rank (`last` is agreed).
         if sim.step() >= last {
+            let tri_material = sim.triangle_materials(&mesh);
             sizes = Some(rank_table::RankSizes::measure(
                 world,
                 &mesh,
-                sim.model.mixed(),
+                sim.model.pressure(&tri_material),
             )?);
         }
     }

@@ -6,10 +6,14 @@
 /// increment is its particle's (`Particles::increment`, the same numbers), so vertices are kept
 /// only where their pressure is a solution value (mixed elements); a midside node carries no
 /// pressure. For P2 that is 3 entries of 32 bytes a particle instead of 4 of 40.
+/// Where a vertex has one pressure per material (a scene of several materials), `vertices`
+/// holds its lowest material's and `by_material` every one; one-material scenes keep no second
+/// copy.
 #[derive(Debug, Default)]
 pub struct NodeValues {
     vertices: Vec<(u64, [f64; 3])>,
     edges: Vec<([u64; 2], [f64; 2])>,
+    by_material: Vec<((u64, u32), f64)>,
 }
 
 impl NodeValues {
@@ -31,7 +35,34 @@ impl NodeValues {
         edges.sort_by_key(|e| e.0);
         edges.dedup_by_key(|e| e.0);
         edges.shrink_to_fit();
-        NodeValues { vertices, edges }
+        NodeValues {
+            vertices,
+            edges,
+            by_material: Vec::new(),
+        }
+    }
+
+    /// With the pressures per (vertex gid, material), in any order; of repeated keys the first
+    /// is kept.
+    pub fn with_material_pressures(
+        mut self,
+        entries: impl IntoIterator<Item = ((u64, u32), f64)>,
+    ) -> Self {
+        let mut by_material: Vec<((u64, u32), f64)> = entries.into_iter().collect();
+        by_material.sort_by_key(|e| e.0);
+        by_material.dedup_by_key(|e| e.0);
+        by_material.shrink_to_fit();
+        self.by_material = by_material;
+        self
+    }
+
+    /// The pressure of vertex `gid` in `material`, where pressures were per material.
+    pub fn pressure(&self, gid: u64, material: u32) -> Option<f64> {
+        let i = self
+            .by_material
+            .binary_search_by_key(&(gid, material), |e| e.0)
+            .ok()?;
+        Some(self.by_material[i].1)
     }
 
     /// The node's displacement increment and pressure (zero at a midside node).
@@ -70,5 +101,19 @@ mod tests {
         let v = NodeValues::new(entries, false);
         assert_eq!(v.get(&[1, 1]), None);
         assert_eq!(v.get(&[5, 9]), Some([1.0, 2.0, 0.0]));
+    }
+
+    #[test]
+    fn pressures_per_material_are_found_by_vertex_and_material() {
+        let v = NodeValues::new([([4, 4], [0.0, 0.0, 1.0])], true).with_material_pressures([
+            ((4, 2), 3.0),
+            ((4, 0), 1.0),
+            ((4, 2), 9.0),
+        ]);
+        assert_eq!(v.pressure(4, 2), Some(3.0));
+        assert_eq!(v.pressure(4, 0), Some(1.0));
+        assert_eq!(v.pressure(4, 1), None);
+        assert_eq!(v.pressure(5, 0), None);
+        assert_eq!(NodeValues::default().pressure(4, 0), None);
     }
 }

@@ -5,7 +5,7 @@
 
 use super::RunError;
 use crate::mesh::LocalMesh;
-use crate::solve::DofMap;
+use crate::solve::{DofMap, Pressure};
 use mpi::traits::Communicator;
 use pfem_partition::{gather_to_root, Comm};
 
@@ -28,8 +28,12 @@ impl RankSizes {
     /// Collective. Measures `mesh`, numbering its dofs again the way the solve does (the
     /// solve's numbering is dropped with its increment, and keeping it alive would add to the
     /// peak memory this table reports).
-    pub fn measure(world: &Comm, mesh: &LocalMesh, mixed: bool) -> Result<RankSizes, RunError> {
-        let dofs = DofMap::build(world, mesh, mixed)?;
+    pub fn measure(
+        world: &Comm,
+        mesh: &LocalMesh,
+        pressure: Pressure,
+    ) -> Result<RankSizes, RunError> {
+        let dofs = DofMap::build(world, mesh, pressure)?;
         let local_dofs: usize = (0..dofs.n_nodes()).map(|n| dofs.ndof(n)).sum();
         Ok(RankSizes {
             owned: mesh.n_owned as u64,

@@ -66,6 +66,11 @@ impl Simulation {
                 records.key.push(*key);
                 records.state.push(states);
                 let mut nodes = [f64::NAN; NODE_LEN];
+                // A vertex with a pressure per material gives its lowest material's: the file
+                // keeps one per vertex, and a triangle's material is not stored to choose by.
+                // Only the next predictor reads it, so a restart of a run of several materials
+                // starts Newton a little off at their interfaces and converges to the same
+                // tolerance, rather than repeating the run bit for bit.
                 for (k, node) in tri_node_keys(key).iter().enumerate() {
                     if let Some(v) = last.get(node) {
                         nodes[3 * k..3 * k + 3].copy_from_slice(&v);

@@ -103,6 +103,15 @@ fn pattern_signature(dofs: &DofMap) -> u64 {
             eat(dofs.node_global[n as usize] as u64);
         }
     }
+    // With pressures per material, the same nodes may meet other materials' pressures.
+    if dofs.material_pressures.is_some() {
+        for t in 0..dofs.tri_nodes.len() {
+            for k in 12..15 {
+                let (n, c) = dofs.element_dof(t, k);
+                eat(dofs.global_dof(n, c) as u64);
+            }
+        }
+    }
     h
 }
 
@@ -133,8 +142,11 @@ pub struct Solved {
     dlambda: f64,
     dofs: DofMap,
     pub(super) du: Vec<[f64; 2]>,
-    /// Pressure of every local node (NaN without a pressure unknown).
+    /// Pressure of every local node (NaN without a pressure unknown; at a vertex with one per
+    /// material, its lowest material's).
     pressure: Vec<f64>,
+    /// (vertex node, material, pressure) of every pressure unknown where they are per material.
+    material_pressure: Vec<(usize, u32, f64)>,
     /// Per local triangle, its Gauss points' rows of the material's layout.
     pub(super) states: Rows,
     reaction: [f64; 2],
@@ -156,6 +168,7 @@ pub struct Solved {
 struct Outcome {
     du: Vec<[f64; 2]>,
     pressure: Vec<f64>,
+    material_pressure: Vec<(usize, u32, f64)>,
     states: Rows,
     reaction: [f64; 2],
     set_reactions: Vec<[f64; 2]>,
@@ -267,8 +280,9 @@ impl Simulation {
         let _ = petsc;
         let err = |e: String| SolveError::Fatal(e);
         let step = self.header.step + 1;
-        let dofs =
-            DofMap::build(world, mesh, self.model.mixed()).map_err(|e| err(e.to_string()))?;
+        let tri_law = self.triangle_materials(mesh);
+        let dofs = DofMap::build(world, mesh, self.model.pressure(&tri_law))
+            .map_err(|e| err(e.to_string()))?;
         let constraints = Constraints::build(&dofs, |p| {
             self.model
                 .step_bc(self.reference_position(mesh, p), mesh.points[p], from, to)
@@ -298,7 +312,7 @@ impl Simulation {
         let spacing = loads.spacing;
         let setup = StepSetup {
             laws: self.model.laws(to),
-            tri_law: self.triangle_materials(mesh),
+            tri_law,
             kernel: self.model.kernel,
             states_n,
             constraints: &constraints,
@@ -325,6 +339,7 @@ impl Simulation {
             dofs,
             du: o.du,
             pressure: o.pressure,
+            material_pressure: o.material_pressure,
             states: o.states,
             reaction: o.reaction,
             set_reactions: o.set_reactions,
@@ -519,7 +534,10 @@ impl Simulation {
         mesh: &LocalMesh,
         dofs: &DofMap,
     ) -> Result<Split, PetscError> {
-        let layout = FieldLayout::new(world, dofs);
+        let layout = FieldLayout::new(world, dofs).map_err(|e| PetscError {
+            code: -1,
+            message: e.to_string(),
+        })?;
         let ints = |v: &[usize]| {
             v.iter()
                 .map(|&g| crate::petsc::matrix::to_int(g, "dof"))
@@ -605,25 +623,36 @@ impl Simulation {
         let inc =
             |p: usize| self.point_value(mesh, p, &self.particles.increment, &self.ghosts.increment);
         let state = |p: usize| self.point_state(mesh, p);
+        // Where pressures are per material, a vertex's pressure in a material it did not touch
+        // in the last increment (or after a restart, whose checkpoint keeps one pressure per
+        // vertex) starts from its pressure in its lowest material there: a value of the last
+        // solution all the same, nearer than the particle's recovered mean.
+        let displacement = |n: usize| {
+            if let Some(v) = last.get(&node_key(mesh, dofs, n)) {
+                return [scale * v[0], scale * v[1]];
+            }
+            let p = dofs.node_point[n];
+            if p != u32::MAX {
+                let d = inc(p as usize);
+                [scale * d[0], scale * d[1]]
+            } else {
+                let [a, b] = dofs.edges[n - (dofs.n_nodes() - dofs.edges.len())];
+                let (da, db) = (inc(a as usize), inc(b as usize));
+                [0.5 * scale * (da[0] + db[0]), 0.5 * scale * (da[1] + db[1])]
+            }
+        };
+        let vertex_pressure = |n: usize, material: u32| {
+            let key = node_key(mesh, dofs, n);
+            if let Some(p) = last.pressure(key[0], material) {
+                return p;
+            }
+            match last.get(&key) {
+                Some(v) => v[2],
+                None => pressure(state(dofs.node_point[n] as usize)),
+            }
+        };
         problem
-            .initial_guess(x, |n| {
-                if let Some(v) = last.get(&node_key(mesh, dofs, n)) {
-                    return [scale * v[0], scale * v[1], v[2]];
-                }
-                let p = dofs.node_point[n];
-                if p != u32::MAX {
-                    let (d, s) = (inc(p as usize), state(p as usize));
-                    [scale * d[0], scale * d[1], pressure(s)]
-                } else {
-                    let [a, b] = dofs.edges[n - (dofs.n_nodes() - dofs.edges.len())];
-                    let (da, db) = (inc(a as usize), inc(b as usize));
-                    [
-                        0.5 * scale * (da[0] + db[0]),
-                        0.5 * scale * (da[1] + db[1]),
-                        0.0,
-                    ]
-                }
-            })
+            .initial_guess(x, displacement, vertex_pressure)
             .map_err(|e| err(e.to_string()))?;
         let mut newton = |problem: &mut StepProblem, x: &mut PVec, jac: &mut Mat| {
             snes.solve(problem, x, jac).map_err(|e| match e {
@@ -718,9 +747,11 @@ impl Simulation {
         }
         let du = problem.node_displacements(&local);
         let pressure = problem.node_pressures(&local);
+        let material_pressure = problem.material_pressures(&local);
         Ok(Outcome {
             du,
             pressure,
+            material_pressure,
             states: converged.states,
             reaction,
             set_reactions,
@@ -797,8 +828,13 @@ impl Simulation {
             let v = [per_step * d[0], per_step * d[1], solved.pressure[n]];
             (node_key(mesh, &solved.dofs, n), v)
         });
+        let by_material = solved.material_pressure.iter().map(|&(n, m, p)| {
+            let gid = node_key(mesh, &solved.dofs, n)[0];
+            ((gid, m), p)
+        });
         *self.last_nodes.borrow_mut() =
-            super::node_values::NodeValues::new(last, self.model.mixed());
+            super::node_values::NodeValues::new(last, self.model.mixed())
+                .with_material_pressures(by_material);
         self.particles.state = recover_at_particles(mesh, &solved.states, &self.particles.state);
         self.tri_states = TriStates::new(mesh, solved.states);
         self.last_reaction = solved.reaction;

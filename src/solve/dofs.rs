@@ -3,6 +3,9 @@
 //! endpoint, which always holds every triangle around that edge. Owned dofs are numbered
 //! contiguously per rank (offsets by exclusive scan); ghost numbers are fetched from their owners.
 
+use super::material_pressures::{
+    number_material_pressures, MaterialPressures, NodeTables, Pressure,
+};
 use crate::mesh::LocalMesh;
 use pfem_partition::{exscan_u64, fetch_pairs, Comm, PartitionError};
 use std::collections::HashMap;
@@ -19,10 +22,15 @@ pub struct DofMap {
     pub edges: Vec<[u32; 2]>,
     /// Per triangle: its 6 nodes (3 vertices CCW, then edges 01, 12, 20).
     pub tri_nodes: Vec<[u32; 6]>,
-    /// Global number of each node's first dof (ux; then uy, then p at a vertex of a mixed mesh).
+    /// Global number of each node's first dof (ux; then uy, then the pressures at a vertex of a
+    /// mixed mesh).
     pub node_global: Vec<usize>,
-    /// Dofs per vertex node: 2, or 3 with a pressure unknown (mixed u–p elements).
+    /// Dofs per vertex node: 2, or 3 with a pressure unknown (mixed u–p elements); with
+    /// `material_pressures`, a vertex has 2 and one per material around it.
     pub vertex_dofs: usize,
+    /// A vertex's pressures per material, where the mesh has several ([`Pressure::PerMaterial`]);
+    /// `None` for one pressure per vertex or none, which need no table.
+    pub material_pressures: Option<MaterialPressures>,
     /// Whether this rank owns the node (and so its two rows).
     pub node_owned: Vec<bool>,
     /// Local point behind each vertex node (`u32::MAX` for edge nodes).
@@ -33,9 +41,18 @@ pub struct DofMap {
 }
 
 impl DofMap {
-    /// Collective. Numbers the dofs of `mesh`; `pressure` adds a pressure unknown at every vertex.
-    pub fn build(comm: &Comm, mesh: &LocalMesh, pressure: bool) -> Result<DofMap, PartitionError> {
-        let vertex_dofs = if pressure { 3 } else { 2 };
+    /// Collective. Numbers the dofs of `mesh` and the vertices' `pressure` unknowns. A vertex's
+    /// dofs are consecutive on its owner: ux, uy, then its pressures by increasing material.
+    pub fn build(
+        comm: &Comm,
+        mesh: &LocalMesh,
+        pressure: Pressure,
+    ) -> Result<DofMap, PartitionError> {
+        let vertex_dofs = if matches!(pressure, Pressure::None) {
+            2
+        } else {
+            3
+        };
         let np = mesh.points.len();
         let mut used = vec![false; np];
         for t in &mesh.tris {
@@ -99,11 +116,21 @@ impl DofMap {
                 *n = node_of_edge[*n as usize];
             }
         }
+        let mut material_pressures = match pressure {
+            Pressure::PerMaterial(tri_material) => Some(MaterialPressures::new(
+                &tri_nodes,
+                tri_material,
+                n_vertex_nodes as usize,
+            )),
+            Pressure::None | Pressure::Continuous => None,
+        };
         let ndof = |n: usize| {
-            if n < n_vertex_nodes as usize {
-                vertex_dofs
-            } else {
+            if n >= n_vertex_nodes as usize {
                 2
+            } else if let Some(mp) = &material_pressures {
+                2 + mp.count(n)
+            } else {
+                vertex_dofs
             }
         };
         let n_owned_dofs: usize = (0..node_owned.len())
@@ -145,6 +172,14 @@ impl DofMap {
         for (n, g) in asked.into_iter().zip(answers) {
             node_global[n] = g as usize;
         }
+        if let Some(mp) = &mut material_pressures {
+            let nodes = NodeTables {
+                point: &node_point[..n_vertex_nodes as usize],
+                owned: &node_owned,
+                global: &node_global,
+            };
+            number_material_pressures(comm, mesh, nodes, mp)?;
+        }
         Ok(DofMap {
             node_of_point,
             edges: sorted_edges,
@@ -153,6 +188,7 @@ impl DofMap {
             node_owned,
             node_point,
             vertex_dofs,
+            material_pressures,
             n_owned_dofs,
             first_dof: first_dof as usize,
             n_global_dofs: n_global_dofs as usize,
@@ -168,10 +204,11 @@ impl DofMap {
     /// under the solve's memory peak).
     pub fn node_local(&self, n: usize) -> usize {
         let vertices = self.n_nodes() - self.edges.len();
-        if n < vertices {
-            self.vertex_dofs * n
-        } else {
-            self.vertex_dofs * vertices + 2 * (n - vertices)
+        match &self.material_pressures {
+            None if n < vertices => self.vertex_dofs * n,
+            None => self.vertex_dofs * vertices + 2 * (n - vertices),
+            Some(mp) if n < vertices => 2 * n + mp.first(n),
+            Some(mp) => 2 * vertices + mp.len() + 2 * (n - vertices),
         }
     }
 
@@ -192,10 +229,63 @@ impl DofMap {
 
     /// Dofs of node `n`.
     pub fn ndof(&self, n: usize) -> usize {
+        2 + self.pressure_count(n)
+    }
+
+    /// Pressure unknowns of node `n`: none at a midside node or without pressures.
+    pub fn pressure_count(&self, n: usize) -> usize {
         if self.node_point[n] == u32::MAX {
-            2
+            0
+        } else if let Some(mp) = &self.material_pressures {
+            mp.count(n)
         } else {
-            self.vertex_dofs
+            self.vertex_dofs - 2
+        }
+    }
+
+    /// The global dof of component `c` of node `n`: ux, uy, then the node's pressures in the
+    /// order of their materials. A ghost vertex may lack some of its owner's materials, so its
+    /// pressures are looked up rather than counted from its first dof.
+    pub fn global_dof(&self, n: usize, c: usize) -> usize {
+        match &self.material_pressures {
+            Some(mp) if c >= 2 => mp.global(n, c - 2),
+            _ => self.node_global[n] + c,
+        }
+    }
+
+    /// Of vertex `k` of triangle `t`, the component of the pressure the triangle reads (that of
+    /// its material).
+    pub fn pressure_component(&self, t: usize, k: usize) -> usize {
+        2 + self
+            .material_pressures
+            .as_ref()
+            .map_or(0, |mp| mp.slot(t, k))
+    }
+
+    /// The local index of the pressure in component `c` (≥ 2) of vertex node `n` among this
+    /// rank's pressure unknowns: the vertex node itself when there is one pressure per vertex.
+    pub fn pressure_unknown(&self, n: usize, c: usize) -> usize {
+        match &self.material_pressures {
+            Some(mp) => mp.unknown(n, c - 2),
+            None => n,
+        }
+    }
+
+    /// The material of the pressure in component `c` (≥ 2) of vertex node `n` (0 when there is
+    /// one pressure per vertex).
+    pub fn pressure_material(&self, n: usize, c: usize) -> u32 {
+        self.material_pressures
+            .as_ref()
+            .map_or(0, |mp| mp.material(n, c - 2))
+    }
+
+    /// Pressure unknowns on this rank (owned and ghost), in the order of
+    /// [`Self::pressure_unknown`].
+    pub fn n_pressure_unknowns(&self) -> usize {
+        match &self.material_pressures {
+            Some(mp) => mp.len(),
+            None if self.vertex_dofs == 3 => self.n_nodes() - self.edges.len(),
+            None => 0,
         }
     }
 
@@ -227,7 +317,7 @@ impl DofMap {
     pub fn ghost_globals(&self) -> Vec<usize> {
         (0..self.n_nodes())
             .filter(|&n| !self.node_owned[n])
-            .flat_map(|n| (0..self.ndof(n)).map(move |c| self.node_global[n] + c))
+            .flat_map(|n| (0..self.ndof(n)).map(move |c| self.global_dof(n, c)))
             .collect()
     }
 
@@ -315,6 +405,9 @@ impl DofMap {
     /// Exact nonzero counts per owned row in the diagonal and off-diagonal blocks, from the mesh
     /// graph: every triangle around an owned node is on this rank.
     pub fn preallocation(&self) -> (Vec<usize>, Vec<usize>) {
+        if self.material_pressures.is_some() {
+            return self.preallocation_by_dof();
+        }
         let cols = self.node_neighbours(6);
         let mut d = vec![0; self.n_owned_dofs];
         let mut o = vec![0; self.n_owned_dofs];
@@ -339,6 +432,29 @@ impl DofMap {
         }
         (d, o)
     }
+
+    /// The local node and component of element dof `k` of triangle `t` (12 displacements and,
+    /// on a mixed mesh, 3 pressures): x and y of the six nodes, then the pressure of the
+    /// triangle's material at each vertex.
+    pub fn element_dof(&self, t: usize, k: usize) -> (usize, usize) {
+        let nodes = &self.tri_nodes[t];
+        if k < 12 {
+            (nodes[k / 2] as usize, k % 2)
+        } else {
+            (nodes[k - 12] as usize, self.pressure_component(t, k - 12))
+        }
+    }
+
+    /// Per owned pressure unknown, in the order of their dofs: how many pressure unknowns
+    /// (itself included) share a triangle with it, owned by this rank and by others: the pattern
+    /// of the P1 pressure mass matrix, which couples a material's pressures only among its own
+    /// triangles.
+    pub fn pressure_neighbour_counts(&self) -> Vec<(usize, usize)> {
+        if self.material_pressures.is_some() {
+            return self.material_pressure_neighbour_counts();
+        }
+        self.vertex_neighbour_counts()
+    }
 }
 
 #[cfg(test)]
@@ -355,6 +471,7 @@ mod tests {
             tri_nodes: Vec::new(),
             node_global: vec![100, 50, 60, 103],
             vertex_dofs: 3,
+            material_pressures: None,
             node_owned: vec![true, false, false, true],
             node_point: vec![0, 1, u32::MAX, u32::MAX],
             n_owned_dofs: 5,

@@ -4,6 +4,7 @@
 pub mod constraints;
 pub mod dofs;
 pub mod interpolation;
+pub mod material_pressures;
 pub mod nullspace;
 pub mod pmg;
 pub mod problem;
@@ -12,5 +13,6 @@ pub mod split;
 
 pub use constraints::Constraints;
 pub use dofs::DofMap;
+pub use material_pressures::Pressure;
 pub use problem::{CoarseOperator, Kernel, Law, SchurPreconditioner, StepProblem, StepSetup};
 pub use split::FieldLayout;

@@ -229,6 +229,7 @@ pub(super) fn one_triangle_dofs(
         tri_nodes: vec![[0, 1, 2, 3, 4, 5]],
         node_global: node_global.to_vec(),
         vertex_dofs: 2,
+        material_pressures: None,
         node_owned: node_owned.to_vec(),
         node_point: vec![0, 1, 2, u32::MAX, u32::MAX, u32::MAX],
         n_owned_dofs: 2 * node_owned.iter().filter(|&&o| o).count(),

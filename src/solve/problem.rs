@@ -141,7 +141,7 @@ pub struct StepProblem<'a> {
 }
 
 /// The pressure mass matrix scaled by −1/G that a Schur-complement preconditioner uses, and
-/// each local node's row in it.
+/// each local pressure unknown's row in it ([`DofMap::pressure_unknown`]).
 pub struct SchurPreconditioner<'a> {
     pub matrix: &'a Mat,
     pub pressure_index: &'a [usize],
@@ -189,14 +189,9 @@ impl<'a> StepProblem<'a> {
     }
 
     /// The local node and component of element dof `k` of triangle `t`: x and y of the six
-    /// nodes, then the vertices' pressures (component 2).
+    /// nodes, then the vertices' pressures of the triangle's material.
     fn element_dof(&self, t: usize, k: usize) -> (usize, usize) {
-        let nodes = &self.dofs.tri_nodes[t];
-        if k < 12 {
-            (nodes[k / 2] as usize, k % 2)
-        } else {
-            (nodes[k - 12] as usize, 2)
-        }
+        self.dofs.element_dof(t, k)
     }
 
     /// The local-vector index of element dof `k` of triangle `t`.
@@ -211,7 +206,7 @@ impl<'a> StepProblem<'a> {
     fn sorted_columns(&self, t: usize, cols: &mut [Int], order: &mut [u8]) {
         let global = |k: usize| {
             let (node, c) = self.element_dof(t, k);
-            self.dofs.node_global[node] + c
+            self.dofs.global_dof(node, c)
         };
         let n = self.dofs_per_element;
         let mut keyed = [(0usize, 0u8); 15];
@@ -278,12 +273,14 @@ impl<'a> StepProblem<'a> {
         }
     }
 
-    /// Initial iterate: the predictor per node (the last step's increment, scaled pressures) with
-    /// prescribed step displacements imposed.
+    /// Initial iterate: the predicted step displacement per node (the last step's increment)
+    /// and pressure per vertex and material (scaled), with prescribed step displacements
+    /// imposed.
     pub fn initial_guess(
         &self,
         x: &PVec,
-        predictor: impl Fn(usize) -> [f64; 3],
+        displacement: impl Fn(usize) -> [f64; 2],
+        pressure: impl Fn(usize, u32) -> f64,
     ) -> Result<(), PetscError> {
         let first = self.dofs.first_dof;
         let scale = self.pressure_scale();
@@ -293,13 +290,12 @@ impl<'a> StepProblem<'a> {
                     continue;
                 }
                 let g = self.dofs.node_global[n] - first;
-                let guess = predictor(n);
-                for c in 0..self.dofs.ndof(n) {
-                    xa[g + c] = match (c, self.setup.constraints.value(n, c)) {
-                        (2, _) => guess[2] / scale,
-                        (_, Some(v)) => v,
-                        _ => guess[c],
-                    };
+                let guess = displacement(n);
+                for c in 0..2 {
+                    xa[g + c] = self.setup.constraints.value(n, c).unwrap_or(guess[c]);
+                }
+                for c in 2..self.dofs.ndof(n) {
+                    xa[g + c] = pressure(n, self.dofs.pressure_material(n, c)) / scale;
                 }
             }
         })
@@ -325,16 +321,38 @@ impl<'a> StepProblem<'a> {
     }
 
     /// Pressure (compression positive) of every local node at `local`; NaN where the node has
-    /// no pressure unknown.
+    /// no pressure unknown. A vertex where several materials meet has one per material: this
+    /// is the one of its lowest material index (see [`Self::material_pressures`] for all). One
+    /// of the solution's own values rather than their mean: a mean lies on neither side of the
+    /// jump, so it would be a worse predictor for both, and the lowest index is the same
+    /// choice on every rank.
     pub fn node_pressures(&self, local: &[f64]) -> Vec<f64> {
         let scale = self.pressure_scale();
         (0..self.dofs.n_nodes())
             .map(|n| {
-                if self.dofs.ndof(n) == 3 {
+                if self.dofs.pressure_count(n) > 0 {
                     scale * local[self.dofs.node_local(n) + 2]
                 } else {
                     f64::NAN
                 }
+            })
+            .collect()
+    }
+
+    /// Where pressures are per material: (vertex node, material, pressure) of every local
+    /// pressure unknown at `local`; empty otherwise.
+    pub fn material_pressures(&self, local: &[f64]) -> Vec<(usize, u32, f64)> {
+        let scale = self.pressure_scale();
+        if self.dofs.material_pressures.is_none() {
+            return Vec::new();
+        }
+        let n_vertex = self.dofs.n_nodes() - self.dofs.edges.len();
+        (0..n_vertex)
+            .flat_map(|n| {
+                (2..self.dofs.ndof(n)).map(move |c| {
+                    let p = scale * local[self.dofs.node_local(n) + c];
+                    (n, self.dofs.pressure_material(n, c), p)
+                })
             })
             .collect()
     }
@@ -1038,9 +1056,14 @@ impl StepProblem<'_> {
             let area = crate::fem::p1::area(&[x[0], x[1], x[2]]);
             let factor = -scale * scale * (1.0 / g.max(f64::MIN_POSITIVE) + 1.0 / bulk);
             let mass = super::split::p1_mass(area);
-            let cols = nodes[..3]
-                .iter()
-                .map(|&n| to_int(schur.pressure_index[n as usize], "pressure"))
+            let cols = (0..3)
+                .map(|k| {
+                    let n = nodes[k] as usize;
+                    let u = self
+                        .dofs
+                        .pressure_unknown(n, self.dofs.pressure_component(t, k));
+                    to_int(schur.pressure_index[u], "pressure")
+                })
                 .collect::<Result<Vec<Int>, _>>()?;
             for a in owned {
                 let vals: Vec<f64> = mass[a].iter().map(|v| factor * v).collect();

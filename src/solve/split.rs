@@ -10,7 +10,7 @@ use crate::fem::p2::physical_gradients;
 use crate::fem::quadrature::{area_to_reference, TRI3_POINTS};
 use crate::material::{GaussState, Material};
 use mpi::traits::Communicator;
-use pfem_partition::{exscan_u64, sum_f64, Comm};
+use pfem_partition::{exscan_u64, fetch_pairs, sum_f64, Comm, PartitionError};
 
 /// The owned dofs of each field and the pressure numbering.
 pub struct FieldLayout {
@@ -18,8 +18,8 @@ pub struct FieldLayout {
     pub displacement: Vec<usize>,
     /// Global dofs of this rank's pressure unknowns.
     pub pressure: Vec<usize>,
-    /// Per local node: its pressure's index in the pressure-only numbering (`usize::MAX` for a
-    /// midside node).
+    /// Per local pressure unknown ([`DofMap::pressure_unknown`]): its index in the
+    /// pressure-only numbering.
     pub pressure_index: Vec<usize>,
     /// Nonzeros per owned pressure row of the P1 mass matrix, in and out of the diagonal block.
     pub mass_d_nnz: Vec<usize>,
@@ -27,24 +27,18 @@ pub struct FieldLayout {
 }
 
 impl FieldLayout {
-    /// Collective. The layout of a mixed `dofs` (vertex nodes carry ux, uy, p).
-    pub fn new(comm: &Comm, dofs: &DofMap) -> FieldLayout {
+    /// Collective. The layout of a mixed `dofs` (vertex nodes carry ux, uy and pressures).
+    pub fn new(comm: &Comm, dofs: &DofMap) -> Result<FieldLayout, PartitionError> {
         assert_eq!(dofs.vertex_dofs, 3, "a field split needs pressure unknowns");
-        let n_vertex = dofs.n_nodes() - dofs.edges.len();
         let mut displacement = Vec::new();
         let mut pressure = Vec::new();
         for n in 0..dofs.n_nodes() {
             if dofs.node_owned[n] {
                 let g = dofs.node_global[n];
                 displacement.extend([g, g + 1]);
-                if n < n_vertex {
-                    pressure.push(g + 2);
-                }
+                pressure.extend((2..dofs.ndof(n)).map(|c| g + c));
             }
         }
-        // A rank numbers its owned vertex nodes first (3 dofs each), so an owned vertex's
-        // position among them is (g - first_dof) / 3 on its owner: with every rank's first
-        // dof and first pressure, any rank numbers any vertex's pressure by itself.
         let (first_p, _) = exscan_u64(comm, pressure.len() as u64);
         let size = comm.size() as usize;
         let mut slots = vec![0.0; 2 * size];
@@ -53,26 +47,57 @@ impl FieldLayout {
         let firsts = sum_f64(comm, &slots);
         let first_dof: Vec<usize> = (0..size).map(|r| firsts[2 * r] as usize).collect();
         let first_pressure: Vec<usize> = (0..size).map(|r| firsts[2 * r + 1] as usize).collect();
-        let pressure_index = (0..dofs.n_nodes())
-            .map(|n| {
-                if n >= n_vertex {
-                    return usize::MAX;
+        // The owner of global dof g: the last rank whose first dof is at or below g (ranks
+        // without dofs share their successor's first dof and come before it).
+        let owner = |g: usize| first_dof.partition_point(|&f| f <= g) - 1;
+        let n_vertex = dofs.n_nodes() - dofs.edges.len();
+        let pressure_index = if dofs.material_pressures.is_none() {
+            // A rank numbers its owned vertex nodes first (3 dofs each), so an owned vertex's
+            // position among them is (g - first_dof) / 3 on its owner: with every rank's first
+            // dof and first pressure, any rank numbers any vertex's pressure by itself.
+            (0..n_vertex)
+                .map(|n| {
+                    let g = dofs.node_global[n];
+                    let r = owner(g);
+                    first_pressure[r] + (g - first_dof[r]) / 3
+                })
+                .collect()
+        } else {
+            // Vertices with several pressures break that count: a ghost pressure's index is
+            // asked of its owner, which finds the dof among its own (increasing) pressures.
+            let mut index = vec![usize::MAX; dofs.n_pressure_unknowns()];
+            let mut requests = Vec::new();
+            let mut asked = Vec::new();
+            for n in 0..n_vertex {
+                for c in 2..dofs.ndof(n) {
+                    let g = dofs.global_dof(n, c);
+                    let u = dofs.pressure_unknown(n, c);
+                    requests.push((owner(g) as i32, [g as u64, 0]));
+                    asked.push(u);
                 }
-                let g = dofs.node_global[n];
-                // The owner: the last rank whose first dof is at or below g (ranks without
-                // dofs share their successor's first dof and come before it).
-                let r = first_dof.partition_point(|&f| f <= g) - 1;
-                first_pressure[r] + (g - first_dof[r]) / 3
-            })
-            .collect();
-        let (mass_d_nnz, mass_o_nnz) = dofs.vertex_neighbour_counts().into_iter().unzip();
-        FieldLayout {
+            }
+            let answers = fetch_pairs(comm, &requests, |k| {
+                let at = pressure.binary_search(&(k[0] as usize)).map_err(|_| {
+                    PartitionError::InvalidInput(format!(
+                        "dof {} asked for as a pressure is not one of its owner's",
+                        k[0]
+                    ))
+                })?;
+                Ok((first_p as usize + at) as u64)
+            })?;
+            for (u, i) in asked.into_iter().zip(answers) {
+                index[u] = i as usize;
+            }
+            index
+        };
+        let (mass_d_nnz, mass_o_nnz) = dofs.pressure_neighbour_counts().into_iter().unzip();
+        Ok(FieldLayout {
             displacement,
             pressure,
             pressure_index,
             mass_d_nnz,
             mass_o_nnz,
-        }
+        })
     }
 }
 
