@@ -221,9 +221,9 @@ impl MohrCoulomb {
                 // The matrix has just been solved with.
                 let col = solve_small(n, &a, &unit).unwrap_or_default();
                 for (i, dn) in dng.iter().enumerate() {
-                    for r in 0..3 {
-                        for c in 0..3 {
-                            ds[r][c] -= dn[r] * col[i] * faces[fj].nf[c];
+                    for (row, dnr) in ds.iter_mut().zip(dn) {
+                        for (v, nf) in row.iter_mut().zip(&faces[fj].nf) {
+                            *v -= dnr * col[i] * nf;
                         }
                     }
                 }

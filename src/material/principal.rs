@@ -55,6 +55,8 @@ impl Spectral {
     /// dσ/dσ_tr in global Voigt components (tensor shear on both sides) of the isotropic
     /// function that maps this (trial) frame's principal values to `values` with derivatives
     /// `dv[i][j]` = ∂σ_i/∂σ_tr,j (indices A, B, Z).
+    // Index loops mirror the component notation of the products.
+    #[allow(clippy::needless_range_loop)]
     pub fn isotropic_tangent(&self, values: &[f64; 3], dv: &[[f64; 3]; 3]) -> [[f64; 4]; 4] {
         let tr = &self.values;
         let gap = tr[0] - tr[1];
@@ -71,8 +73,8 @@ impl Spectral {
             local[i][..3].copy_from_slice(&dv[i]);
         }
         local[3][3] = spin;
-        let to = self.to_frame(1.0);
-        let from = self.to_frame(-1.0);
+        let to = self.frame_map(1.0);
+        let from = self.frame_map(-1.0);
         let mut out = [[0.0; 4]; 4];
         for i in 0..4 {
             for j in 0..4 {
@@ -85,7 +87,7 @@ impl Spectral {
     }
 
     /// The map of tensor-shear Voigt stresses into the eigenframe (`sign` 1) or back (−1).
-    fn to_frame(&self, sign: f64) -> [[f64; 4]; 4] {
+    fn frame_map(&self, sign: f64) -> [[f64; 4]; 4] {
         let (c, s) = (self.cos, sign * self.sin);
         [
             [c * c, s * s, 0.0, 2.0 * c * s],
@@ -118,8 +120,9 @@ pub fn solve_small(n: usize, a: &[[f64; 3]; 3], b: &[f64; 3]) -> Option<[f64; 3]
         x.swap(col, piv);
         for row in col + 1..n {
             let f = m[row][col] / m[col][col];
-            for k in col..n {
-                m[row][k] -= f * m[col][k];
+            let pivot_row = m[col];
+            for (mk, pk) in m[row][col..n].iter_mut().zip(&pivot_row[col..n]) {
+                *mk -= f * pk;
             }
             x[row] -= f * x[col];
         }
