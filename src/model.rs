@@ -1,12 +1,16 @@
 //! What a scene means for the solver: material, element, supports, prescribed motion, loads.
 
 use crate::geometry::NamedBoundaries;
+use crate::material::drucker_prager::{DruckerPrager, Match};
 use crate::material::elastic::LinearElastic;
+use crate::material::mohr_coulomb::MohrCoulomb;
 use crate::material::placed::{union_layout, Placed};
 use crate::material::tresca::{CuProfile, Tresca};
 use crate::material::{InternalVar, Material, MaterialError, StateLayout};
 use crate::rigid::RigidBody;
-use crate::scene::{Axis, ElementChoice, Fixed, MaterialModel, Prescribed, Scene, Selection};
+use crate::scene::{
+    Axis, ConeMatch, ElementChoice, Fixed, MaterialModel, Prescribed, Scene, Selection,
+};
 use crate::solve::Kernel;
 use crate::solve::Law;
 use crate::solve::Pressure;
@@ -20,6 +24,9 @@ fn model_variables(m: &crate::scene::Material) -> &'static [InternalVar] {
             &crate::material::tresca::VARIABLES_WITH_CU
         }
         MaterialModel::Tresca => &crate::material::tresca::VARIABLES,
+        MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager => {
+            &crate::material::mohr_coulomb::VARIABLES
+        }
     }
 }
 
@@ -64,7 +71,33 @@ fn material_of(m: &crate::scene::Material) -> Result<Box<dyn Material>, Material
                 _ => Box::new(t),
             }
         }
+        MaterialModel::MohrCoulomb => {
+            let [c, phi, psi] = strength(m);
+            Box::new(MohrCoulomb::new(
+                m.young,
+                m.poisson,
+                c,
+                phi,
+                psi,
+                m.tension_cutoff,
+            )?)
+        }
+        MaterialModel::DruckerPrager => {
+            let [c, phi, psi] = strength(m);
+            let fit = match m.cone_match.unwrap_or_default() {
+                ConeMatch::PlaneStrain => Match::PlaneStrain,
+                ConeMatch::Outer => Match::Outer,
+                ConeMatch::Inner => Match::Inner,
+            };
+            Box::new(DruckerPrager::new(m.young, m.poisson, c, phi, psi, fit)?)
+        }
     })
+}
+
+/// c, φ, ψ of a frictional material (validation has required them; a missing one is NaN, which
+/// the model rejects by name).
+fn strength(m: &crate::scene::Material) -> [f64; 3] {
+    [m.cohesion, m.friction_angle, m.dilation_angle].map(|v| v.unwrap_or(f64::NAN))
 }
 
 /// The named edges of a scene's zones (empty for a body of rectangles).

@@ -14,11 +14,14 @@
 //! refine = true         # particle insertion/removal (default true)
 //! smooth = false        # Laplacian smoothing of interior particles (default false)
 //! [material]
-//! model = "linear-elastic"   # or "tresca"
+//! model = "linear-elastic"   # or "tresca", "mohr-coulomb", "drucker-prager"
 //! young = 12.0e6             # Pa
 //! poisson = 0.2
 //! density = 0.0              # kg/m3 (default 0); body force = density * gravity.g
 //! cu = 0.0                   # Pa, undrained shear strength, "tresca" only (default 0)
+//! # "mohr-coulomb" and "drucker-prager": cohesion (Pa), friction_angle and dilation_angle
+//! # (degrees, dilation <= friction); tension_cutoff (Pa, "mohr-coulomb", optional);
+//! # match = "plane-strain" | "outer" | "inner" ("drucker-prager", default "plane-strain")
 //! [gravity]                  # optional
 //! g = [0.0, 0.0]             # m/s2
 //! [[fixed]]                  # zero displacement; selection re-evaluated on every remesh
@@ -95,9 +98,9 @@ pub use rigid::{
     SurfacePressure,
 };
 pub use schema::{
-    Body, Dof, ElementChoice, FineRegion, Fixed, Gravity, History, HistoryKind, ImportedNode,
-    LineSearch, LinearChoice, Material, MaterialModel, Mesh, Output, PointLoad, Prescribed,
-    Rectangle, Scene, Selection, Solver, Steps,
+    Body, ConeMatch, Dof, ElementChoice, FineRegion, Fixed, Gravity, History, HistoryKind,
+    ImportedNode, LineSearch, LinearChoice, Material, MaterialModel, Mesh, Output, PointLoad,
+    Prescribed, Rectangle, Scene, Selection, Solver, Steps,
 };
 pub use selector::{Axis, Comparison, Condition, Selector};
 

@@ -77,6 +77,23 @@ pub fn render(
                         );
                     }
                 }
+                if let (Some(c), Some(phi), Some(psi)) =
+                    (m.cohesion, m.friction_angle, m.dilation_angle)
+                {
+                    let _ = write!(
+                        model,
+                        ", c = {} Pa, phi = {} deg, psi = {} deg",
+                        num(c),
+                        num(phi),
+                        num(psi)
+                    );
+                }
+                if let Some(t) = m.tension_cutoff {
+                    let _ = write!(model, ", tension cut-off {} Pa", num(t));
+                }
+                if let Some(f) = m.cone_match {
+                    let _ = write!(model, ", {f:?} match");
+                }
                 line("material", model);
             }
             let mut mesh = format!("h = {} m, alpha = {}", num(sc.mesh.h), num(sc.mesh.alpha));

@@ -170,6 +170,8 @@ pub fn p2_element_with(
     let mut residual = [0.0; N_DOFS];
     let mut tangent = [[0.0; N_DOFS]; N_DOFS];
     let mut states = states_n.clone();
+    // Non-associated flow: the full product, nothing mirrored. Otherwise the upper triangle.
+    let full = !mat.symmetric_tangent();
 
     for q in 0..N_GAUSS {
         let xi = area_to_reference(TRI3_POINTS[q]);
@@ -220,12 +222,12 @@ pub fn p2_element_with(
         }
 
         // Weighted D·B on the in-plane rows (B's zz row is zero), so the material stiffness
-        // below is a plain Bᵀ·(wDB) product. The tangent is symmetric (the geometric part
-        // always, the material part for the laws here): its upper triangle is formed, and
-        // mirrored once after the last Gauss point, which halves the work.
+        // below is a plain Bᵀ·(wDB) product. Where the material says its tangent is symmetric
+        // the element's is too (the geometric part always is): its upper triangle is formed,
+        // and mirrored once after the last Gauss point, which halves the work.
         const IN_PLANE: [usize; 3] = [0, 1, 3];
         debug_assert!(
-            (0..4).all(|i| (0..i).all(|j| (d[i][j] - d[j][i]).abs()
+            full || (0..4).all(|i| (0..i).all(|j| (d[i][j] - d[j][i]).abs()
                 <= 1e-9 * d.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs())))),
             "the material tangent is not symmetric: {d:?}"
         );
@@ -242,7 +244,7 @@ pub fn p2_element_with(
         }
         for (k, row) in tangent.iter_mut().enumerate() {
             let bk = [b[0][k], b[1][k], b[3][k]];
-            for (l, r) in row.iter_mut().enumerate().skip(k) {
+            for (l, r) in row.iter_mut().enumerate().skip(if full { 0 } else { k }) {
                 *r += bk[0] * db[0][l] + bk[1] * db[1][l] + bk[2] * db[2][l];
             }
         }
@@ -250,14 +252,14 @@ pub fn p2_element_with(
         // Geometric stiffness: (∇N_a · S ∇N_b) on both diagonal displacement components.
         for (a, ga) in g.iter().enumerate() {
             let sa = [s[0] * ga[0] + s[3] * ga[1], s[3] * ga[0] + s[1] * ga[1]];
-            for (bn, gb) in g.iter().enumerate().skip(a) {
+            for (bn, gb) in g.iter().enumerate().skip(if full { 0 } else { a }) {
                 let kg = w * (sa[0] * gb[0] + sa[1] * gb[1]);
                 tangent[2 * a][2 * bn] += kg;
                 tangent[2 * a + 1][2 * bn + 1] += kg;
             }
         }
     }
-    if with_tangent {
+    if with_tangent && !full {
         for k in 1..N_DOFS {
             let (upper, lower) = tangent.split_at_mut(k);
             for (l, row) in upper.iter().enumerate() {
@@ -420,6 +422,43 @@ mod tests {
             geo_norm / den.sqrt() > 1e-3,
             "geometric stiffness unexpectedly negligible"
         );
+    }
+
+    #[test]
+    fn non_associated_tangent_is_formed_in_full() {
+        use crate::material::mohr_coulomb::MohrCoulomb;
+        let x = curved_element();
+        let states = prestress();
+        let body = [0.0; 2];
+        let f = [[1.004, 0.003], [0.001, 0.993]];
+        let du = homogeneous_du(&x, &f, [0.5, 0.2]);
+        for psi in [30.0, 5.0] {
+            let mat = MohrCoulomb::new(30e6, 0.3, 5e3, 30.0, psi, None).expect("valid");
+            let out = p2_element(&x, &du, &states, &mat, body).expect("valid element");
+            assert!(out.states.iter().any(|s| s.internal[4] > 0.0), "must yield");
+            let h = 1e-9;
+            let (mut num, mut den, mut asym) = (0.0, 0.0, 0.0f64);
+            for l in 0..N_DOFS {
+                let (mut p, mut m) = (du, du);
+                p[l / 2][l % 2] += h;
+                m[l / 2][l % 2] -= h;
+                let rp = p2_element(&x, &p, &states, &mat, body).expect("valid element");
+                let rm = p2_element(&x, &m, &states, &mat, body).expect("valid element");
+                for k in 0..N_DOFS {
+                    let fd = (rp.residual[k] - rm.residual[k]) / (2.0 * h);
+                    num += (fd - out.tangent[k][l]).powi(2);
+                    den += out.tangent[k][l].powi(2);
+                    asym = asym.max((out.tangent[k][l] - out.tangent[l][k]).abs());
+                }
+            }
+            let rel = (num / den).sqrt();
+            assert!(rel < 1e-6, "ψ = {psi}: relative tangent error {rel:e}");
+            if psi == 30.0 {
+                assert!(asym <= 1e-9 * den.sqrt(), "associated: symmetric");
+            } else {
+                assert!(asym > 1e-4 * den.sqrt(), "non-associated: {asym:e}");
+            }
+        }
     }
 
     #[test]

@@ -50,6 +50,27 @@
 //! matrix as unsymmetric for quadratic Newton convergence; a symmetric factorisation of its
 //! symmetric part is a valid but only linearly convergent Newton variant.
 //!
+//! # Pressure-dependent and dilatant models
+//! The above is for a model that is [`Material::isochoric`] (elasticity, Tresca): its deviator
+//! ignores the mean stress and its plastic flow keeps the volume, so the element may take the
+//! deviator alone and close the pressure with the elastic volume law. A frictional model
+//! (Mohr–Coulomb, Drucker–Prager) needs the pressure for its strength and changes volume as it
+//! flows. For it the material returns its full stress σ_m (pressure p_m = −tr σ_m/3 included, a
+//! dilatant return changing it), the momentum balance takes dev σ_m and the field p as above,
+//! and the volume equation makes p the L2 projection of the material's pressure:
+//! r_i = −∫_{Ω_n} L_i (p − p_m(ε)) / K dV.
+//! For an elastic or isochoric state p_m = p_n − K ln J, so this is the equation above with
+//! ln J for J − 1 (the two agree to O((J − 1)²)), and the element stays free of volumetric
+//! locking as before: the K-sized volumetric stiffness enters only through the weakly enforced
+//! P1 relation, never pointwise. Plastic volume change enters through p_m: a point that dilates
+//! has p_m below its elastic value and the projection lets the P1 volume follow. A uniform
+//! state has p = p_m exactly, so a block's stress is the material's to round-off. Its
+//! derivative: ∂r_i/∂H = ∫ L_i (∂p_m/∂ε)(∂ε/∂H) / K, which is −(K_up)ᵀ only up to a factor J
+//! and the model's pressure–deviator coupling: non-symmetric, as the step's solvers assume for
+//! any plastic scene. The stored stress is dev σ_m (rotated) − p I, as for the other models: the
+//! pressure history is the field's, which keeps point-to-point noise in the P2 divergence out
+//! of the next step's strength.
+//!
 //! # Conditioning
 //! Displacement and pressure rows have different units: K_uu ~ G, K_up ~ h (element size),
 //! K_pp ~ h²/K. [`MixedOutput::with_pressure_scale`] with α = G/h (any representative G and h
@@ -278,7 +299,10 @@ pub fn p2p1_element(
     bulk: f64,
     body_force: [f64; 2],
 ) -> Result<MixedOutput, ElementError> {
-    if bulk.is_nan() || bulk <= 0.0 {
+    // A model that is not isochoric takes K as the scale of its projected pressure, which
+    // must then be finite.
+    let isochoric = mat.isochoric();
+    if bulk.is_nan() || bulk <= 0.0 || (!isochoric && bulk.is_infinite()) {
         return Err(invalid_bulk(bulk));
     }
     let inv_k = 1.0 / bulk;
@@ -344,7 +368,21 @@ pub fn p2p1_element(
                 residual[2 * a + i] += w * (f - n[a] * body_force[i]);
             }
         }
-        let vol = kin.jm1 + (p_h - p_n) * inv_k;
+        let vol = if isochoric {
+            kin.jm1 + (p_h - p_n) * inv_k
+        } else {
+            (p_h + (resp.s[0] + resp.s[1] + resp.s[2]) / 3.0) * inv_k
+        };
+        // ∂p_m/∂H_jl = −⅓ tr(D ∂ε/∂H_jl), for the volume rows of a model that is not isochoric.
+        let mut dpm = [0.0; 4];
+        if !isochoric {
+            for (dp, de) in dpm.iter_mut().zip(&kin.deps) {
+                *dp = -(0..3)
+                    .map(|r| (0..4).map(|c| resp.d[r][c] * de[c]).sum::<f64>())
+                    .sum::<f64>()
+                    / 3.0;
+            }
+        }
         for (i, li) in lp.iter().enumerate() {
             residual[N_U_DOFS + i] -= w * li * vol;
         }
@@ -397,11 +435,14 @@ pub fn p2p1_element(
                         tangent[2 * a + i][col] += w * v;
                     }
                 }
-                // K_pu[m][(b, jj)] = −w J L_m (∇_x N_b)_jj, and K_up is its exact transpose.
+                // K_up[(b, jj)][m] = −w J L_m (∇_x N_b)_jj; for an isochoric model K_pu is
+                // its exact transpose.
+                let dpm_b = dpm[2 * jj] * gb0[0] + dpm[2 * jj + 1] * gb0[1];
                 for (m, lm) in lp.iter().enumerate() {
                     let c = -w * j * lm * gs[bn][jj];
-                    tangent[N_U_DOFS + m][col] += c;
                     tangent[col][N_U_DOFS + m] += c;
+                    tangent[N_U_DOFS + m][col] +=
+                        if isochoric { c } else { w * lm * dpm_b * inv_k };
                 }
             }
         }

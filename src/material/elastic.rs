@@ -90,6 +90,10 @@ impl Material for LinearElastic {
     fn name(&self) -> &'static str {
         "linear_elastic"
     }
+
+    fn isochoric(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]

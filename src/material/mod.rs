@@ -13,9 +13,12 @@
 //! prestress enters S unchanged. Turning S into the end-of-step Cauchy stress needs the deformation
 //! gradient, so that is the element's job, not the material's.
 
+pub mod drucker_prager;
 pub mod elastic;
 pub mod layout;
+pub mod mohr_coulomb;
 pub mod placed;
+pub mod principal;
 pub mod tresca;
 
 pub use layout::{InternalVar, Rows, StateLayout, VarKind, STRESS_LEN};
@@ -144,9 +147,9 @@ pub trait Material: Send + Sync + fmt::Debug {
     /// `state_n` is the converged state at x_n (its `stress` is the Cauchy stress σ_n);
     /// `e` is the Green–Lagrange strain of the step relative to x_n (Voigt, engineering shear,
     /// `e[2] = 0` in plane strain). Must not mutate anything: Newton iterations call it repeatedly
-    /// from the same `state_n`. `d` must be symmetric (the P2 element forms the upper triangle
-    /// of its tangent and mirrors it): a law with a non-symmetric tangent (non-associated flow)
-    /// would need the element's full product back.
+    /// from the same `state_n`. `d` must be symmetric unless [`Material::symmetric_tangent`]
+    /// says otherwise (the P2 element then forms its full product instead of mirroring the upper
+    /// triangle).
     fn update(&self, state_n: &GaussState, e: &[f64; 4])
         -> Result<MaterialResponse, MaterialError>;
 
@@ -157,7 +160,8 @@ pub trait Material: Send + Sync + fmt::Debug {
     /// ε = ln U = ½ ln(FᵀF) (Voigt, engineering shear, `eps[2] = 0`), expressed in the
     /// start-of-step frame. The returned `s` is then the end-of-step Cauchy stress *before* the
     /// rotation R is applied (σ_{n+1} = R s Rᵀ), and `d = ds/dε`. Elements that supply their own
-    /// pressure field use only the deviatoric parts of `s` and `d`.
+    /// pressure field use only the deviatoric parts of `s` and `d` when the model is
+    /// [`Material::isochoric`], and otherwise also its pressure and the pressure's derivative.
     ///
     /// The default forwards to [`Material::update`]: the models in this module are of the form
     /// σ_n + ΔS(strain) with ΔS a small-strain law, which is exactly a rate-form (hypoelastic /
@@ -198,6 +202,21 @@ pub trait Material: Send + Sync + fmt::Debug {
 
     /// Whether a Gauss point yielded in going from `before` to `after`.
     fn yielded(&self, _before: &GaussState, _after: &GaussState) -> bool {
+        false
+    }
+
+    /// Whether `d` is always symmetric. False for non-associated flow: every element and
+    /// solver path that would mirror or assume symmetry then takes the full matrix.
+    fn symmetric_tangent(&self) -> bool {
+        true
+    }
+
+    /// Whether the deviatoric response ignores the mean stress and plastic flow keeps the
+    /// volume (elasticity, Tresca): the mixed element may then take the deviator alone and
+    /// close the pressure with its own volume law. False (the default, safe for any model):
+    /// the element takes the model's own pressure as well, which a pressure-dependent or
+    /// dilatant model needs.
+    fn isochoric(&self) -> bool {
         false
     }
 }

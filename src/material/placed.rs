@@ -150,6 +150,14 @@ impl Material for Placed {
     fn yielded(&self, before: &GaussState, after: &GaussState) -> bool {
         self.inner.yielded(&self.own(before), &self.own(after))
     }
+
+    fn symmetric_tangent(&self) -> bool {
+        self.inner.symmetric_tangent()
+    }
+
+    fn isochoric(&self) -> bool {
+        self.inner.isochoric()
+    }
 }
 
 #[cfg(test)]

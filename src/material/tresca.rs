@@ -271,6 +271,10 @@ impl Material for Tresca {
         true
     }
 
+    fn isochoric(&self) -> bool {
+        true
+    }
+
     fn yielded(&self, before: &GaussState, after: &GaussState) -> bool {
         let q = |s: &GaussState| s.internal.get(EPS_Q).copied().unwrap_or(0.0);
         q(after) > q(before)

@@ -291,6 +291,12 @@ pub enum MaterialModel {
     LinearElastic,
     /// `"tresca"`: elastic-perfectly plastic with undrained shear strength `cu`.
     Tresca,
+    /// `"mohr-coulomb"`: drained, elastic-perfectly plastic: `cohesion`, `friction_angle`,
+    /// `dilation_angle`, optional `tension_cutoff`.
+    MohrCoulomb,
+    /// `"drucker-prager"`: the smooth cone matched to Mohr–Coulomb's `cohesion`,
+    /// `friction_angle`, `dilation_angle` by `match`.
+    DruckerPrager,
 }
 
 impl MaterialModel {
@@ -298,8 +304,31 @@ impl MaterialModel {
         match self {
             MaterialModel::LinearElastic => "linear-elastic",
             MaterialModel::Tresca => "tresca",
+            MaterialModel::MohrCoulomb => "mohr-coulomb",
+            MaterialModel::DruckerPrager => "drucker-prager",
         }
     }
+
+    /// Whether the model's strength depends on the mean stress (Mohr–Coulomb, Drucker–Prager).
+    pub fn frictional(self) -> bool {
+        matches!(
+            self,
+            MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager
+        )
+    }
+}
+
+/// `match` of a `"drucker-prager"` material: which Mohr–Coulomb section the cone fits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ConeMatch {
+    /// The cone whose plane-strain limit state is Mohr–Coulomb's (the default).
+    #[default]
+    PlaneStrain,
+    /// Through Mohr–Coulomb's triaxial-compression corners (circumscribed).
+    Outer,
+    /// Through its triaxial-extension corners.
+    Inner,
 }
 
 /// The scene's materials: one `[material]` table, or an array of named `[[material]]` tables.
@@ -374,7 +403,7 @@ pub struct Material {
     /// The name zones give in `material = "..."`; required with several materials.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
-    /// `"linear-elastic"` or `"tresca"`.
+    /// `"linear-elastic"`, `"tresca"`, `"mohr-coulomb"` or `"drucker-prager"`.
     pub model: MaterialModel,
     /// Young's modulus (Pa), > 0.
     pub young: f64,
@@ -396,6 +425,24 @@ pub struct Material {
     /// Level (m) below which `cu_gradient` applies; required with it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference_level: Option<f64>,
+    /// `"mohr-coulomb"` and `"drucker-prager"`: cohesion c (Pa), >= 0 (> 0 when
+    /// friction_angle = 0). Required.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cohesion: Option<f64>,
+    /// Their friction angle φ (degrees), 0 <= φ < 90. Required.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_angle: Option<f64>,
+    /// Their dilation angle ψ (degrees), 0 <= ψ <= φ: ψ = φ is associated flow, ψ < φ gives a
+    /// non-symmetric tangent (LU and GMRES, as for every plastic scene). Required.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dilation_angle: Option<f64>,
+    /// `"mohr-coulomb"` only: the largest principal stress (Pa, tension positive), >= 0.
+    /// Default: none (the cone's apex c cot φ bounds tension).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tension_cutoff: Option<f64>,
+    /// `"drucker-prager"` only: `"plane-strain"` (default), `"outer"` or `"inner"`.
+    #[serde(default, rename = "match", skip_serializing_if = "Option::is_none")]
+    pub cone_match: Option<ConeMatch>,
 }
 
 fn is_zero(x: &f64) -> bool {
@@ -666,8 +713,9 @@ pub struct Solver {
     pub newton_max_it: u32,
     /// Relative residual tolerance, 0 < newton_rtol < 1. Default 1e-9.
     pub newton_rtol: f64,
-    /// `"auto"` (default: `"p2p1"` for `"tresca"`, `"p2"` otherwise), `"p2"` (6-node displacement
-    /// triangles) or `"p2p1"` (Taylor–Hood mixed u–p: P2 displacement, P1 pressure).
+    /// `"auto"` (default: `"p2p1"` where a material yields, `"p2"` otherwise), `"p2"` (6-node
+    /// displacement triangles) or `"p2p1"` (Taylor–Hood mixed u–p: P2 displacement, P1
+    /// pressure; a frictional model's own pressure is projected onto the P1 field).
     pub element: ElementChoice,
     /// Newton's line search: `"auto"` (default: `"basic"`, full steps, for elastic scenes;
     /// `"bt"`, backtracking, for plastic ones), `"basic"`, `"bt"`, `"l2"` (secant on the

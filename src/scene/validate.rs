@@ -333,6 +333,18 @@ fn check_fields(s: &Scene) -> Result<(), Invalid> {
                 ),
             );
         }
+        Some(k @ (HistoryKind::Footing | HistoryKind::Block)) if s.material.model.frictional() => {
+            return fail(
+                kind,
+                format!(
+                    "\"{}\" divides by cu and draws Tresca's collapse loads, which a \"{}\" \
+                     material has not: declare the columns instead ([[history.columns]], e.g. \
+                     `reaction.NAME.fy` with a scale of -1/(c B))",
+                    k.as_str(),
+                    s.material.model.as_str()
+                ),
+            );
+        }
         _ => {}
     }
 
@@ -639,6 +651,7 @@ fn check_material(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invali
         );
     }
     non_negative(mat.join("density"), m.density)?;
+    foreign_keys(m, mat)?;
     match m.model {
         MaterialModel::Tresca => {
             if !(m.cu > 0.0 && m.cu.is_finite()) {
@@ -649,22 +662,95 @@ fn check_material(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invali
             }
             cu_profile(s, m, mat)
         }
-        MaterialModel::LinearElastic => {
-            non_negative(mat.join("cu"), m.cu)?;
-            if m.cu_gradient != 0.0 || m.reference_level.is_some() {
-                let key = if m.cu_gradient != 0.0 {
-                    "cu_gradient"
-                } else {
-                    "reference_level"
-                };
-                return fail(
-                    mat.join(key),
-                    "is a parameter of model \"tresca\", not of \"linear-elastic\"".to_string(),
-                );
+        MaterialModel::LinearElastic => non_negative(mat.join("cu"), m.cu),
+        MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager => {
+            let mut strength = [0.0; 3];
+            for (v, (key, given)) in strength.iter_mut().zip([
+                ("cohesion", m.cohesion),
+                ("friction_angle", m.friction_angle),
+                ("dilation_angle", m.dilation_angle),
+            ]) {
+                *v = given.ok_or_else(|| {
+                    (
+                        mat.join(key),
+                        format!("is required for model \"{}\"", m.model.as_str()),
+                    )
+                })?;
             }
-            Ok(())
+            let [c, phi, psi] = strength;
+            let checked =
+                crate::material::mohr_coulomb::check_strength(c, phi, psi).and_then(|()| {
+                    match m.tension_cutoff {
+                        Some(t) => crate::material::mohr_coulomb::MohrCoulomb::new(
+                            m.young,
+                            m.poisson,
+                            c,
+                            phi,
+                            psi,
+                            Some(t),
+                        )
+                        .map(|_| ()),
+                        None => Ok(()),
+                    }
+                });
+            match checked {
+                Err(crate::material::MaterialError::InvalidParameter {
+                    name,
+                    value,
+                    requirement,
+                }) => fail(
+                    mat.join(name),
+                    format!("must satisfy {requirement} (got {value})"),
+                ),
+                _ => Ok(()),
+            }
         }
     }
+}
+
+/// The keys of other models than `m`'s, each rejected by name: a table holds exactly its
+/// model's parameters.
+fn foreign_keys(m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
+    use MaterialModel::*;
+    let given: [(&str, bool, &[MaterialModel]); 8] = [
+        ("cu", m.cu != 0.0, &[Tresca, LinearElastic]),
+        ("cu_gradient", m.cu_gradient != 0.0, &[Tresca]),
+        ("reference_level", m.reference_level.is_some(), &[Tresca]),
+        (
+            "cohesion",
+            m.cohesion.is_some(),
+            &[MohrCoulomb, DruckerPrager],
+        ),
+        (
+            "friction_angle",
+            m.friction_angle.is_some(),
+            &[MohrCoulomb, DruckerPrager],
+        ),
+        (
+            "dilation_angle",
+            m.dilation_angle.is_some(),
+            &[MohrCoulomb, DruckerPrager],
+        ),
+        ("tension_cutoff", m.tension_cutoff.is_some(), &[MohrCoulomb]),
+        ("match", m.cone_match.is_some(), &[DruckerPrager]),
+    ];
+    for (key, present, owners) in given {
+        if present && !owners.contains(&m.model) {
+            let names: Vec<String> = owners
+                .iter()
+                .map(|o| format!("\"{}\"", o.as_str()))
+                .collect();
+            return fail(
+                mat.join(key),
+                format!(
+                    "is a parameter of model {}, not of \"{}\"",
+                    names.join(" and "),
+                    m.model.as_str()
+                ),
+            );
+        }
+    }
+    Ok(())
 }
 
 /// A Tresca strength profile: a finite gradient with its reference level, and cu > 0 down to the

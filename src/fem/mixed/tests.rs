@@ -310,6 +310,48 @@ fn tangent_matches_finite_differences_plastic_prestressed_rotated() {
 }
 
 #[test]
+fn tangent_matches_finite_differences_frictional_dilatant() {
+    use crate::material::drucker_prager::{DruckerPrager, Match};
+    use crate::material::mohr_coulomb::MohrCoulomb;
+    let x = curved_element();
+    let st = prestress();
+    let mc = |psi| MohrCoulomb::new(6.0e6, 0.3, 5.0e3, 30.0, psi, None).expect("valid");
+    let dp = |psi| DruckerPrager::new(6.0e6, 0.3, 5.0e3, 30.0, psi, Match::PlaneStrain);
+    let models: Vec<Box<dyn Material>> = vec![
+        Box::new(mc(30.0)),
+        Box::new(mc(5.0)),
+        Box::new(dp(30.0).expect("valid")),
+        Box::new(dp(0.0).expect("valid")),
+    ];
+    let bulk = 6.0e6 / (3.0 * 0.4);
+    for mat in &models {
+        assert!(!mat.isochoric());
+        for scale in [0.3, 0.1] {
+            let du = big_step(&x, scale);
+            let p = [1.1e5, 1.4e5, 0.9e5];
+            let out = p2p1_element(&x, &du, &p, &st, mat.as_ref(), bulk, [0.0; 2]).expect("ok");
+            assert!(
+                out.states.iter().all(|s| s.internal[EPS_Q] > 0.0),
+                "{mat:?} must flow plastically"
+            );
+            let err = fd_errors(&x, &du, &p, &st, mat.as_ref(), bulk);
+            assert!(err.iter().all(|e| *e < 1e-6), "{mat:?} {scale}: {err:?}");
+        }
+    }
+    // Not isochoric needs a finite K: it scales the projected pressure.
+    let r = p2p1_element(
+        &x,
+        &big_step(&x, 0.01),
+        &[0.0; 3],
+        &st,
+        &mc(0.0),
+        f64::INFINITY,
+        [0.0; 2],
+    );
+    assert!(matches!(r, Err(ElementError::Material { .. })));
+}
+
+#[test]
 fn pressure_coupling_is_an_exact_transpose() {
     let x = curved_element();
     let st = prestress();
