@@ -63,7 +63,10 @@ fn material_of(m: &crate::scene::Material) -> Result<Box<dyn Material>, Material
             Box::new(LinearElastic::new(m.young, m.poisson).map_err(named)?)
         }
         MaterialModel::Tresca => {
-            let t = Tresca::new(m.young, m.poisson, m.cu).map_err(named)?;
+            let mut t = Tresca::new(m.young, m.poisson, m.cu).map_err(named)?;
+            if let Some(ratio) = m.young_over_cu {
+                t = t.with_young_over_cu(ratio);
+            }
             match (m.cu_gradient, m.reference_level) {
                 (k, Some(level)) if k != 0.0 => {
                     Box::new(t.with_profile(CuProfile { gradient: k, level }))

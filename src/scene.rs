@@ -173,6 +173,12 @@ impl Scene {
             field: Some(path.to_string()),
             ..SceneError::new(source, message)
         };
+        // `young` left out beside `young_over_cu` is the stiffness at the strength `cu`.
+        for m in scene.material.0.iter_mut() {
+            if let (Some(ratio), 0.0) = (m.young_over_cu, m.young) {
+                m.young = ratio * m.cu;
+            }
+        }
         gmsh_body::import(&mut scene, source).map_err(invalid)?;
         zones::apply_within(&mut scene).map_err(invalid)?;
         scene.steps.count =

@@ -727,3 +727,43 @@ fn an_equilibrated_geostatic_slope_stays_where_it_was_drawn() {
     );
     assert!(stays < 1e-9 * moved, "{stays} against {moved}");
 }
+
+/// The graded block with E = 300 cu at every point, squeezed elastically (ε = 2e-6): its layers
+/// work in parallel, so the platen force is ε ∫ E(y) dy / (1 − ν²) with E(y) = 300 cu(y).
+#[test]
+fn stiffness_proportional_to_strength_follows_the_profile() {
+    let dir = workdir("young-over-cu");
+    let text = GRADED_BLOCK
+        .replace("young = 3.0e6", "young_over_cu = 300.0")
+        .replace("total = [0.025, 0.0]", "total = [1.0e-6, 0.0]")
+        .replace("total = [-0.025, 0.0]", "total = [-1.0e-6, 0.0]")
+        .replace("count = 10", "count = 1");
+    std::fs::write(dir.join("e.toml"), &text).unwrap();
+    ok(&dir, 1, &["new", "e.toml", "-o", "e.h5"]);
+    let info = ok(&dir, 1, &["info", "e.h5"]);
+    assert!(
+        info.contains("E = 3.0000e6 Pa") && info.contains("E = 300 cu"),
+        "{info}"
+    );
+    ok(&dir, 2, &["e.h5", "--out", "r"]);
+    let (_, rows) = history(&dir.join("r/history.csv"));
+    let force = -rows[0][1];
+    // cu from 15 kPa at the bottom to 10 kPa at the top: mean 12.5 kPa.
+    let exact = 2.0e-6 * 300.0 * 12.5e3 / (1.0 - 0.49 * 0.49);
+    println!("platen force {force} against {exact}");
+    assert!(
+        (force - exact).abs() < 1e-4 * exact,
+        "{force} against {exact}"
+    );
+    let both = text.replace(
+        "young_over_cu = 300.0",
+        "young_over_cu = 300.0\nyoung = 1.0e6",
+    );
+    std::fs::write(dir.join("both.toml"), both).unwrap();
+    let out = run(&dir, 1, &["new", "both.toml", "-o", "b.h5"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("material.young"),
+        "{err}"
+    );
+}

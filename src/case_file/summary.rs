@@ -76,6 +76,9 @@ pub fn render(
                             num(level)
                         );
                     }
+                    if let Some(ratio) = m.young_over_cu {
+                        let _ = write!(model, ", E = {} cu at every point", num(ratio));
+                    }
                 }
                 if let (Some(c), Some(phi), Some(psi)) =
                     (m.cohesion, m.friction_angle, m.dilation_angle)

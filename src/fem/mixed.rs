@@ -325,6 +325,8 @@ pub fn p2p1_element(
         let j = kin.j;
         let r = &kin.rot;
 
+        // A stiffness that varies from point to point (`young_over_cu`) varies K too.
+        let inv_k = mat.bulk_at(&states_n[q]).map_or(inv_k, |k| 1.0 / k);
         let p_h = lp[0] * p[0] + lp[1] * p[1] + lp[2] * p[2];
         let sn = &states_n[q].stress;
         let p_n = -(sn[0] + sn[1] + sn[2]) / 3.0;

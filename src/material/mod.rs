@@ -211,6 +211,13 @@ pub trait Material: Send + Sync + fmt::Debug {
         true
     }
 
+    /// The bulk modulus of the mixed element's volume law at a point in state `state`, when
+    /// the model's stiffness varies from point to point (`young_over_cu`); None: the material's
+    /// one bulk modulus.
+    fn bulk_at(&self, _state: &GaussState) -> Option<f64> {
+        None
+    }
+
     /// Whether the deviatoric response ignores the mean stress and plastic flow keeps the
     /// volume (elasticity, Tresca): the mixed element may then take the deviator alone and
     /// close the pressure with its own volume law. False (the default, safe for any model):

@@ -158,6 +158,10 @@ impl Material for Placed {
     fn isochoric(&self) -> bool {
         self.inner.isochoric()
     }
+
+    fn bulk_at(&self, state: &GaussState) -> Option<f64> {
+        self.inner.bulk_at(&self.own(state))
+    }
 }
 
 #[cfg(test)]

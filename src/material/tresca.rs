@@ -90,6 +90,9 @@ pub struct Tresca {
     pub cu: f64,
     /// Strength that varies with the initial depth of a point; None: uniform `cu`.
     pub profile: Option<CuProfile>,
+    /// E / cu at every point (offshore practice: stiffness grows with strength), instead of one
+    /// `young`; None: E = `young` everywhere.
+    pub young_over_cu: Option<f64>,
 }
 
 /// Deviatoric projector on Voigt vectors, engineering shear on the strain side (tensor shear
@@ -128,6 +131,7 @@ impl Tresca {
             poisson,
             cu,
             profile: None,
+            young_over_cu: None,
         })
     }
 
@@ -137,6 +141,34 @@ impl Tresca {
         Self {
             profile: Some(profile),
             ..self
+        }
+    }
+
+    /// The same material with E = `ratio` · cu at every point (`young` then stands for the
+    /// stiffness at the strength `cu`).
+    pub fn with_young_over_cu(self, ratio: f64) -> Self {
+        Self {
+            young_over_cu: Some(ratio),
+            ..self
+        }
+    }
+
+    /// The elastic constants at a point of strength `cu`: this material, or with E = ratio · cu.
+    fn at_strength(&self, cu: f64) -> Tresca {
+        match self.young_over_cu {
+            Some(ratio) => Tresca {
+                young: ratio * cu,
+                ..*self
+            },
+            None => *self,
+        }
+    }
+
+    /// The strength of a point in state `state` (laid out as this model's variables).
+    fn strength_of(&self, state: &GaussState) -> f64 {
+        match self.profile {
+            Some(_) => state.internal.get(CU).copied().unwrap_or(self.cu),
+            None => self.cu,
         }
     }
 
@@ -198,56 +230,13 @@ impl Material for Tresca {
         state_n: &GaussState,
         e: &[f64; 4],
     ) -> Result<MaterialResponse, MaterialError> {
-        // The elastic trial state is the linear-elastic update (which also rejects bad strains).
-        let trial = LinearElastic {
-            young: self.young,
-            poisson: self.poisson,
-        }
-        .update(state_n, e)?;
-        let (mut s, d_el) = (trial.s, trial.d);
-        let a = 0.5 * (s[0] - s[1]);
-        let tau = s[3];
-        let r = a.hypot(tau);
-        let mut state = state_n.clone();
-        let len = internal_len(self.internal_variables());
-        if state.internal.len() != len {
-            // A fresh point (no internal variables yet) starts them at zero.
-            state.internal.resize(len, 0.0);
-        }
-        let cu = match self.profile {
-            Some(_) => state.internal[CU],
-            None => self.cu,
-        };
+        let here = self.at_strength(self.strength_of(state_n));
+        here.update_at_strength(state_n, e)
+    }
 
-        // Strict comparison: a returned state has r = cu to round-off, so a tolerance would only
-        // let round-off excursions above cu survive.
-        if r <= cu {
-            return Ok(MaterialResponse { s, d: d_el, state });
-        }
-
-        let beta = cu / r;
-        let dlambda = (r - cu) / self.shear_modulus();
-        let shrink = 1.0 - beta;
-        s[0] -= shrink * a;
-        s[1] += shrink * a;
-        s[3] -= shrink * tau;
-
-        // Δε^p = Δλ ∂f/∂σ = Δλ/(2r) (a, −a, 0, τ) as a tensor; engineering shear doubles τ.
-        let c = dlambda / (2.0 * r);
-        let ep = &mut state.internal[PLASTIC_STRAIN..PLASTIC_STRAIN + 4];
-        ep[0] += c * a;
-        ep[1] -= c * a;
-        ep[3] += 2.0 * c * tau;
-        state.internal[EPS_Q] += dlambda / 3.0_f64.sqrt();
-
-        // Unit in-plane deviator (Frobenius norm √(2a² + 2τ²) = √2 r).
-        let nrm = std::f64::consts::SQRT_2 * r;
-        let n = [a / nrm, -a / nrm, 0.0, tau / nrm];
-        Ok(MaterialResponse {
-            s,
-            d: self.tangent(beta, Some(&n)),
-            state,
-        })
+    fn bulk_at(&self, state: &GaussState) -> Option<f64> {
+        self.young_over_cu
+            .map(|_| self.at_strength(self.strength_of(state)).bulk_modulus())
     }
 
     fn name(&self) -> &'static str {
@@ -278,6 +267,63 @@ impl Material for Tresca {
     fn yielded(&self, before: &GaussState, after: &GaussState) -> bool {
         let q = |s: &GaussState| s.internal.get(EPS_Q).copied().unwrap_or(0.0);
         q(after) > q(before)
+    }
+}
+
+impl Tresca {
+    /// The return mapping with this value's elastic constants (those of the point's strength).
+    fn update_at_strength(
+        &self,
+        state_n: &GaussState,
+        e: &[f64; 4],
+    ) -> Result<MaterialResponse, MaterialError> {
+        // The elastic trial state is the linear-elastic update (which also rejects bad strains).
+        let trial = LinearElastic {
+            young: self.young,
+            poisson: self.poisson,
+        }
+        .update(state_n, e)?;
+        let (mut s, d_el) = (trial.s, trial.d);
+        let a = 0.5 * (s[0] - s[1]);
+        let tau = s[3];
+        let r = a.hypot(tau);
+        let mut state = state_n.clone();
+        let len = internal_len(self.internal_variables());
+        if state.internal.len() != len {
+            // A fresh point (no internal variables yet) starts them at zero.
+            state.internal.resize(len, 0.0);
+        }
+        let cu = self.strength_of(&state);
+
+        // Strict comparison: a returned state has r = cu to round-off, so a tolerance would only
+        // let round-off excursions above cu survive.
+        if r <= cu {
+            return Ok(MaterialResponse { s, d: d_el, state });
+        }
+
+        let beta = cu / r;
+        let dlambda = (r - cu) / self.shear_modulus();
+        let shrink = 1.0 - beta;
+        s[0] -= shrink * a;
+        s[1] += shrink * a;
+        s[3] -= shrink * tau;
+
+        // Δε^p = Δλ ∂f/∂σ = Δλ/(2r) (a, −a, 0, τ) as a tensor; engineering shear doubles τ.
+        let c = dlambda / (2.0 * r);
+        let ep = &mut state.internal[PLASTIC_STRAIN..PLASTIC_STRAIN + 4];
+        ep[0] += c * a;
+        ep[1] -= c * a;
+        ep[3] += 2.0 * c * tau;
+        state.internal[EPS_Q] += dlambda / 3.0_f64.sqrt();
+
+        // Unit in-plane deviator (Frobenius norm √(2a² + 2τ²) = √2 r).
+        let nrm = std::f64::consts::SQRT_2 * r;
+        let n = [a / nrm, -a / nrm, 0.0, tau / nrm];
+        Ok(MaterialResponse {
+            s,
+            d: self.tangent(beta, Some(&n)),
+            state,
+        })
     }
 }
 

@@ -405,7 +405,9 @@ pub struct Material {
     pub name: Option<String>,
     /// `"linear-elastic"`, `"tresca"`, `"mohr-coulomb"` or `"drucker-prager"`.
     pub model: MaterialModel,
-    /// Young's modulus (Pa), > 0.
+    /// Young's modulus (Pa), > 0. Required, except for `"tresca"` with `young_over_cu`, where it
+    /// is the stiffness at the strength `cu` (young_over_cu · cu, filled in when left out).
+    #[serde(default)]
     pub young: f64,
     /// Poisson's ratio, -1 < poisson < 0.5.
     pub poisson: f64,
@@ -425,6 +427,11 @@ pub struct Material {
     /// Level (m) below which `cu_gradient` applies; required with it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference_level: Option<f64>,
+    /// `"tresca"` only: E = young_over_cu · cu at every point (offshore practice, typically
+    /// 100–500), so the stiffness grows with `cu_gradient` as the strength does; the mixed
+    /// element's bulk modulus follows point by point. Default: one `young` everywhere.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub young_over_cu: Option<f64>,
     /// `"mohr-coulomb"` and `"drucker-prager"`: cohesion c (Pa), >= 0 (> 0 when
     /// friction_angle = 0). Required.
     #[serde(default, skip_serializing_if = "Option::is_none")]

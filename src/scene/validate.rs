@@ -642,6 +642,20 @@ fn check_materials(s: &Scene) -> Result<(), Invalid> {
 
 /// The parameters of one material, at `mat`.
 fn check_material(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
+    if let Some(ratio) = m.young_over_cu {
+        positive(mat.join("young_over_cu"), ratio)?;
+        let derived = ratio * m.cu;
+        if (m.young - derived).abs() > 1e-12 * derived.abs() {
+            return fail(
+                mat.join("young"),
+                format!(
+                    "is young_over_cu · cu = {derived:e} Pa with young_over_cu, or left out \
+                     (got {:e})",
+                    m.young
+                ),
+            );
+        }
+    }
     positive(mat.join("young"), m.young)?;
     let nu = m.poisson;
     if !(nu > -1.0 && nu < 0.5) {
@@ -712,10 +726,11 @@ fn check_material(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invali
 /// model's parameters.
 fn foreign_keys(m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
     use MaterialModel::*;
-    let given: [(&str, bool, &[MaterialModel]); 8] = [
+    let given: [(&str, bool, &[MaterialModel]); 9] = [
         ("cu", m.cu != 0.0, &[Tresca, LinearElastic]),
         ("cu_gradient", m.cu_gradient != 0.0, &[Tresca]),
         ("reference_level", m.reference_level.is_some(), &[Tresca]),
+        ("young_over_cu", m.young_over_cu.is_some(), &[Tresca]),
         (
             "cohesion",
             m.cohesion.is_some(),
