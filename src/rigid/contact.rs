@@ -106,25 +106,34 @@ pub fn node_law(pair: &ContactPair, shape: &Shape, u: [f64; 2], r: [f64; 2]) -> 
     let w = pair.weight;
     let (c, scale) = (pair.constant, pair.row_scale);
     let floor = if pair.touching { -pair.suction } else { 0.0 };
-    let identity = [[1.0, 0.0], [0.0, 1.0]];
+    let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
+    // Let go, a touching node is still pulled by its suction: the ambient pressure the soil is
+    // modelled without acts on it across the opening gap (the branch p = −suction, which keeps
+    // the law semi-smooth: such a node comes back when it would penetrate).
+    let pull = -floor;
     let free = NodeLaw {
         status: Status::Free,
-        rows: r,
-        transform: identity,
-        local: [[0.0; 2]; 2],
-        force: [0.0; 2],
-        pressure: 0.0,
+        rows: [r[0] + pull * w * n[0], r[1] + pull * w * n[1]],
+        transform: [[1.0, 0.0], [0.0, 1.0]],
+        local: std::array::from_fn(|i| std::array::from_fn(|j| pull * w * kappa * t[i] * t[j])),
+        force: [-pull * w * n[0], -pull * w * n[1]],
+        pressure: -pull,
         shear: 0.0,
         gap,
     };
-    let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
     match pair.free {
         [true, true] => {}
         [false, false] => return free,
         [fx, _] => {
             let f = if fx { 0 } else { 1 };
             if n[f].abs() < MIN_FREE_NORMAL {
-                return free;
+                return NodeLaw {
+                    rows: r,
+                    local: [[0.0; 2]; 2],
+                    force: [0.0; 2],
+                    pressure: 0.0,
+                    ..free
+                };
             }
             // The prescribed component's reaction takes the rest of the force.
             let p = r[f] / (w * n[f]);
@@ -275,6 +284,14 @@ mod tests {
             check_tangent(&away, &circle, [0.0; 2], [0.0; 2]),
             Status::Free
         );
+        // Let go while it held suction: pulled by it across the gap.
+        away.touching = true;
+        away.suction = 1e4;
+        assert_eq!(
+            check_tangent(&away, &circle, [0.0; 2], [0.0; 2]),
+            Status::Free
+        );
+        assert_eq!(node_law(&away, &circle, [0.0; 2], [0.0; 2]).pressure, -1e4);
         // A flat face, and a node on a symmetry plane (x prescribed).
         let square =
             Shape::polygon(&[[-1.0, -2.0], [1.0, -2.0], [1.0, -1.0], [-1.0, -1.0]], 0.0).unwrap();
