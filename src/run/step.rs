@@ -663,11 +663,6 @@ impl Simulation {
         let set_reactions = self.set_reactions(mesh, dofs, &problem, &converged, from);
         let laws = problem.contact_laws(&local);
         self.check_contact_gaps(world, problem.contact_pairs(), &laws, spacing, step)?;
-        if std::env::var_os("PFEM_DEBUG_CONTACT").is_some() {
-            for (c, l) in problem.contact_pairs().iter().zip(&laws) {
-                eprintln!("DBG step {step} x {:.5} {:.5} free {:?} touching {} {:?} gap {:.3e} off {:.3e} p {:.4e} tau {:.4e} f {:?} w {:.3e}", c.start[0], c.start[1], c.free, c.touching, l.status, l.gap, c.offset, l.pressure, l.shear, l.force, c.weight);
-            }
-        }
         let mut body_force = vec![[0.0; 2]; self.model.bodies.len()];
         let mut contact_state = super::contact::ContactState::new();
         for (c, law) in problem.contact_pairs().iter().zip(&laws) {
