@@ -161,7 +161,11 @@ pub fn node_law(pair: &ContactPair, shape: &Shape, u: [f64; 2], r: [f64; 2]) -> 
     let tau = -dot(t, r) / w;
     // The normal row takes the slot of the normal's larger component, the tangential row the
     // other: each row then keeps a diagonal of the size of its own.
-    let (a, b) = if n[0].abs() > n[1].abs() { (0, 1) } else { (1, 0) };
+    let (a, b) = if n[0].abs() > n[1].abs() {
+        (0, 1)
+    } else {
+        (1, 0)
+    };
     let mut law = NodeLaw {
         status: Status::Stick,
         rows: [0.0; 2],
@@ -242,7 +246,10 @@ mod tests {
             })
         });
         let h = 1e-8;
-        let scale = analytic.iter().flatten().fold(1e-12_f64, |m, v| m.max(v.abs()));
+        let scale = analytic
+            .iter()
+            .flatten()
+            .fold(1e-12_f64, |m, v| m.max(v.abs()));
         for j in 0..2 {
             let (mut up, mut um) = (u, u);
             up[j] += h;
@@ -327,7 +334,11 @@ mod tests {
         rough.start = [0.2, -0.99];
         rough.body_increment = [0.0, 0.0];
         let slide = node_law(&rough, &square, [0.01, -0.01], [0.0, 400.0]);
-        assert_eq!(slide.status, Status::Slip(-1), "t = (-1, 0) on the top face");
+        assert_eq!(
+            slide.status,
+            Status::Slip(-1),
+            "t = (-1, 0) on the top face"
+        );
         assert_eq!(slide.shear, -500.0);
         assert!((slide.rows[0] - (-0.05 * 500.0)).abs() < 1e-12);
     }

@@ -277,7 +277,12 @@ impl Simulation {
 }
 
 /// Start position, spacing and global key of local node `n`.
-fn node_info(mesh: &LocalMesh, dofs: &DofMap, n: usize, n_vertex: usize) -> ([f64; 2], f64, [u64; 2]) {
+fn node_info(
+    mesh: &LocalMesh,
+    dofs: &DofMap,
+    n: usize,
+    n_vertex: usize,
+) -> ([f64; 2], f64, [u64; 2]) {
     if n < n_vertex {
         let p = dofs.node_point[n] as usize;
         (mesh.points[p], mesh.h[p], [mesh.gids[p]; 2])

@@ -298,9 +298,6 @@ mod tests {
         let soft = divergence_advice(&model(&["material.young=1e-300"]), false);
         assert!(soft.contains("material.young = 1e-300 Pa"), "{soft}");
         let contact = divergence_advice(&model(&[]), true);
-        assert!(
-            contact.contains("contact.tolerance (= 1e-6"),
-            "{contact}"
-        );
+        assert!(contact.contains("contact.tolerance (= 1e-6"), "{contact}");
     }
 }

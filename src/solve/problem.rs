@@ -637,7 +637,11 @@ impl<'a> StepProblem<'a> {
     fn note_statuses(&self, laws: &[NodeLaw]) {
         let mut last = self.statuses.borrow_mut();
         if last.len() == laws.len() {
-            let changed = last.iter().zip(laws).filter(|(a, l)| **a != l.status).count();
+            let changed = last
+                .iter()
+                .zip(laws)
+                .filter(|(a, l)| **a != l.status)
+                .count();
             self.switches.set(self.switches.get() + changed);
         }
         *last = laws.iter().map(|l| l.status).collect();
@@ -762,7 +766,11 @@ impl StepProblem<'_> {
         laws: &[NodeLaw],
     ) -> std::borrow::Cow<'t, [f64]> {
         let nodes = &self.dofs.tri_nodes[t];
-        if laws.is_empty() || nodes.iter().all(|&n| self.pair_of_node[n as usize] == NO_PAIR) {
+        if laws.is_empty()
+            || nodes
+                .iter()
+                .all(|&n| self.pair_of_node[n as usize] == NO_PAIR)
+        {
             return std::borrow::Cow::Borrowed(tangent);
         }
         let width = self.dofs_per_element;
