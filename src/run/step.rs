@@ -9,7 +9,7 @@ use crate::petsc::linear::{p_multigrid_from_options, upper_triangle_smoother_fro
 use crate::petsc::{
     IndexSet, LinearSolver, Mat, NullSpace, PVec, Petsc, PetscError, Snes, SolveFailure,
 };
-use crate::scene::{LineSearch, LinearChoice};
+use crate::scene::LinearChoice;
 use crate::solve::interpolation::{Interpolation, InterpolationMap};
 use crate::solve::nullspace::orthonormal_rigid_body_modes;
 use crate::solve::pmg::CoarseSpace;
@@ -361,21 +361,8 @@ impl Simulation {
         drop(cached);
         let x = PVec::mpi(world, dofs.n_owned_dofs)?;
         let solver = &self.model.scene.solver;
-        let line_search = match solver.line_search {
-            LineSearch::Auto if self.model.plastic() => "bt",
-            LineSearch::Auto | LineSearch::Basic => "basic",
-            LineSearch::Bt => "bt",
-            LineSearch::L2 => "l2",
-            LineSearch::Cp => "cp",
-        };
-        // The retry after a divergence: full steps if the line search backtracked, else
-        // backtracking. Backtracking can stall at a kink of the plastic or contact response that
-        // a full step jumps over, and a full step can overshoot where backtracking does not.
-        let line_search = match (alternate, line_search) {
-            (false, ls) => ls,
-            (true, "bt") => "basic",
-            (true, _) => "bt",
-        };
+        let line_search =
+            super::step_solver::StepSolver::of(&self.model, MAX_CUTS).line_search(alternate);
         let iterative = match solver.linear {
             LinearChoice::Direct => false,
             LinearChoice::Iterative => true,
@@ -811,7 +798,7 @@ impl Simulation {
 }
 
 /// Halvings of a step's increment before a Newton failure is final.
-const MAX_CUTS: usize = 6;
+pub(super) const MAX_CUTS: usize = 6;
 
 impl Simulation {
     /// Collective. Solves the next step on `mesh` and moves the particles. When Newton diverges,
