@@ -79,6 +79,12 @@ fn new(world: &Comm, scene: &str, out: &std::path::Path, sets: &[String]) -> Res
     }
     write_case(world, out, &header, &set)?;
     if world.rank() == 0 {
+        if let Some(n) = scene_v.contact.max_augmentations {
+            eprintln!(
+                "pfem-mpi: warning: scene '{scene}': contact.max_augmentations = {n} is no longer \
+                 read: contact is solved inside every Newton iteration"
+            );
+        }
         for name in crate::scene::zones::unused_materials(&scene_v) {
             eprintln!(
                 "pfem-mpi: warning: scene '{scene}': [[material]] \"{name}\" is named by no \

@@ -487,7 +487,7 @@ fn share_work_vector(snes: ffi::SNES, x: VecRef<'_>) -> Result<(), PetscError> {
     if !basic {
         return Ok(());
     }
-    // Once per set-up: a later solve on the same SNES (contact's augmentations) finds the line
+    // Once per set-up: a later solve on the same SNES (a retried or cut increment on the same pattern) finds the line
     // search's vectors in place.
     let mut w: ffi::Vec = std::ptr::null_mut();
     // SAFETY: as above; the vectors are only looked at.

@@ -1,6 +1,6 @@
-//! Rigid bodies pushed into the soil: convex shapes, their staged motion, and the penalty
-//! contact with augmentation between them and the soil's boundary nodes. Pure numerics: no MPI,
-//! no PETSc.
+//! Rigid bodies pushed into the soil: convex shapes, their staged motion, and the contact law
+//! between them and the soil's boundary nodes that Newton solves with the soil. Pure numerics:
+//! no MPI, no PETSc.
 
 pub mod body;
 pub mod contact;
@@ -8,7 +8,7 @@ pub mod edge_tree;
 pub mod shape;
 
 pub use body::RigidBody;
-pub use contact::{pair_force, ContactPair, PairForce};
+pub use contact::{node_law, ContactPair, NodeLaw, Status};
 pub use shape::{Proximity, Shape};
 
 /// A triangle reaching deeper than this fraction of its spacing (or of the body's inradius)

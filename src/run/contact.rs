@@ -5,8 +5,8 @@ use super::step::edge_key;
 use super::Simulation;
 use crate::fem::surface_load::simpson_weights;
 use crate::mesh::LocalMesh;
-use crate::rigid::{ContactPair, Shape};
-use crate::solve::DofMap;
+use crate::rigid::{ContactPair, NodeLaw, Shape, Status};
+use crate::solve::{Constraints, DofMap};
 use std::collections::HashMap;
 
 /// Contact pairs with each pair's node spacing, the bodies at the end of the increment, and the
@@ -20,17 +20,20 @@ pub(super) struct BoundaryLoads {
     pub surface_edges: Vec<usize>,
 }
 
-/// Contact state kept per node between increments: (node key, body) → (pressure, shear).
+/// Contact state kept per node between increments: (node key, body) → (pressure, shear) of
+/// the nodes touching at the end of the last one.
 pub(super) type ContactState = HashMap<([u64; 2], u32), [f64; 2]>;
 
 impl Simulation {
-    /// Rank-local. Boundary nodes near each rigid body become contact pairs (owned nodes only;
-    /// the search looks only inside each body's box grown by the search margin), and boundary
+    /// Rank-local. Boundary nodes near each rigid body become contact pairs (owned nodes with a
+    /// free component only; the search looks only inside each body's box grown by the search
+    /// margin), and boundary
     /// edges whose ends started inside a `[[surface_pressure]]` region carry its pressure.
     pub(super) fn boundary_loads(
         &self,
         mesh: &LocalMesh,
         dofs: &DofMap,
+        constraints: &Constraints,
         from: f64,
         to: f64,
     ) -> BoundaryLoads {
@@ -89,7 +92,7 @@ impl Simulation {
         }
         let young = model.scene.material.young;
         let carried = self.last_contact.borrow();
-        let none = super::contact::ContactState::new();
+        let none = ContactState::new();
         let state = if model.scene.contact.carry_state {
             &*carried
         } else {
@@ -126,79 +129,37 @@ impl Simulation {
                 .collect();
             nodes.sort_unstable_by_key(|(n, _)| *n);
             for &(n, w) in &nodes {
-                let (x, h, key, points) = node_info(mesh, dofs, n as usize, n_vertex);
+                let (x, h, key) = node_info(mesh, dofs, n as usize, n_vertex);
                 // A midside node of an edge cut across a (rounded) corner starts well inside the
                 // body, where the normal turns fast or jumps between faces: Newton stalls on
                 // it. Its edge's ends carry the contact there. (A chord on a circle dips in by
                 // h²/8R only.)
-                if shape_from.closest(x).distance < -0.25 * shape_from.radius() - 1e-6 * h {
+                let start = shape_from.closest(x).distance;
+                if start < -0.25 * shape_from.radius() - 1e-6 * h {
                     continue;
                 }
-                let touching = state.contains_key(&(key, bi as u32));
-                let carried = state.get(&(key, bi as u32)).copied().unwrap_or_else(|| {
-                    // A new edge node starts from the mean of its ends; a node new to the
-                    // contact from the normal stress the soil carries there, so that a body
-                    // wished in place in stressed ground starts in equilibrium.
-                    let [a, b] = key;
-                    let ends = [
-                        state.get(&([a, a], bi as u32)),
-                        state.get(&([b, b], bi as u32)),
-                    ];
-                    let v: Vec<[f64; 2]> = ends.into_iter().flatten().copied().collect();
-                    if a != b && !v.is_empty() {
-                        let k = v.len() as f64;
-                        return [
-                            v.iter().map(|s| s[0]).sum::<f64>() / k,
-                            v.iter().map(|s| s[1]).sum::<f64>() / k,
-                        ];
-                    }
-                    let prox = shape.closest(x);
-                    if prox.distance > 0.25 * h || !model.scene.contact.carry_state {
-                        return [0.0; 2];
-                    }
-                    let sigma = |p: usize| {
-                        let s = self.point_state(mesh, p);
-                        [s[0], s[1], s[3]]
-                    };
-                    let (sa, sb) = (sigma(points[0]), sigma(points[1]));
-                    let s: [f64; 3] = std::array::from_fn(|k| 0.5 * (sa[k] + sb[k]));
-                    let nn = prox.normal;
-                    let normal =
-                        s[0] * nn[0] * nn[0] + 2.0 * s[2] * nn[0] * nn[1] + s[1] * nn[1] * nn[1];
-                    [(-normal).max(0.0), 0.0]
-                });
+                let free = [0, 1].map(|c| !constraints.is_fixed(n as usize, c));
+                if free == [false, false] {
+                    continue;
+                }
+                // Touching: in contact at the end of the last increment, or, for a body that
+                // holds suction, lying on it now (the soil on a bar's back follows it).
+                let touching = state.contains_key(&(key, bi as u32))
+                    || body.suction > 0.0 && start <= 0.01 * h;
                 out.pairs.push(ContactPair {
                     node: n,
                     body: bi as u32,
                     start: x,
                     weight: w,
-                    penalty: model.scene.contact.penalty * young / h,
-                    multiplier: carried[0],
-                    shear_start: carried[1],
+                    constant: model.scene.contact.penalty * young / h,
+                    row_scale: young / h,
                     shear_limit: body.shear_limit,
                     body_increment: inc,
-                    offset: shape_from.closest(x).distance.min(0.0),
-                    active: false,
+                    offset: start.min(0.0),
+                    touching,
                     suction: body.suction,
-                    slip: if body.shear_limit > 0.0 && carried[1].abs() >= body.shear_limit {
-                        carried[1].signum() as i8
-                    } else {
-                        0
-                    },
-                    last_change: 0.0,
-                    raised: 0,
+                    free,
                 });
-                // Active when it touched at the end of the last increment, or when the body,
-                // where it will be, presses on the node where it is (suction does not reach
-                // across a gap).
-                let last = out.pairs.len() - 1;
-                let p = &mut out.pairs[last];
-                // A body that holds suction keeps what lies on it at the start of the
-                // increment, as the soil on a bar's back follows it.
-                let on_body = p.suction > 0.0 && shape_from.closest(x).distance <= 0.01 * h;
-                p.active = touching
-                    || on_body
-                    || p.multiplier - p.penalty * (shape.closest(x).distance - p.offset) > 0.0;
                 out.spacing.push(h);
             }
         }
@@ -236,6 +197,47 @@ impl Simulation {
             }
             None => Ok(()),
         }
+    }
+}
+
+impl Simulation {
+    /// Collective. Whether the converged contact holds every node on the body's face to
+    /// `contact.tolerance` of its spacing: a touching node's gap, and a free node's
+    /// penetration. Newton's tolerance puts them far below it; a node past it means the
+    /// residual converged without the gaps closing, and a smaller increment is tried.
+    pub(super) fn check_contact_gaps(
+        &self,
+        world: &pfem_partition::Comm,
+        pairs: &[ContactPair],
+        laws: &[NodeLaw],
+        spacing: &[f64],
+        step: u64,
+    ) -> Result<(), super::step::SolveError> {
+        if self.model.bodies.is_empty() {
+            return Ok(());
+        }
+        let off = pairs
+            .iter()
+            .zip(laws)
+            .zip(spacing)
+            .map(|((_, law), h)| {
+                let gap = if law.status == Status::Free {
+                    (-law.gap).max(0.0)
+                } else {
+                    law.gap.abs()
+                };
+                gap / h
+            })
+            .fold(0.0, f64::max);
+        let off = pfem_partition::max_f64(world, off);
+        let tolerance = self.model.scene.contact.tolerance;
+        if off > tolerance {
+            return Err(super::step::SolveError::ContactUnsettled(format!(
+                "step {step}: a contact node ended {off:.1e} of its spacing off the body's face \
+                 (contact.tolerance = {tolerance:e})"
+            )));
+        }
+        Ok(())
     }
 }
 
@@ -281,17 +283,16 @@ impl Simulation {
     }
 }
 
-/// Start position, spacing, global key and end points (twice the point for a vertex) of local
-/// node `n`.
+/// Start position, spacing and global key of local node `n`.
 fn node_info(
     mesh: &LocalMesh,
     dofs: &DofMap,
     n: usize,
     n_vertex: usize,
-) -> ([f64; 2], f64, [u64; 2], [usize; 2]) {
+) -> ([f64; 2], f64, [u64; 2]) {
     if n < n_vertex {
         let p = dofs.node_point[n] as usize;
-        (mesh.points[p], mesh.h[p], [mesh.gids[p]; 2], [p, p])
+        (mesh.points[p], mesh.h[p], [mesh.gids[p]; 2])
     } else {
         let [a, b] = dofs.edges[n - n_vertex].map(|p| p as usize);
         let (xa, xb) = (mesh.points[a], mesh.points[b]);
@@ -299,7 +300,6 @@ fn node_info(
             [0.5 * (xa[0] + xb[0]), 0.5 * (xa[1] + xb[1])],
             mesh.h[a].max(mesh.h[b]),
             edge_key(mesh.gids[a], mesh.gids[b]),
-            [a, b],
         )
     }
 }

@@ -15,6 +15,7 @@ mod sanity;
 mod signals;
 mod simulation;
 mod step;
+mod step_solver;
 mod test_hooks;
 
 pub use error::{RunError, EXIT_FAILURE, EXIT_USAGE};
@@ -82,6 +83,12 @@ fn drive(
     let sim = held.insert(Simulation::load(world, &opts.case)?);
     sanity::check_until_step(opts, sim)?;
     let mut out = output::Output::open(world, sim, &opts.out_dir)?;
+    if world.rank() == 0 {
+        println!(
+            "step solver: {}",
+            step_solver::StepSolver::of(&sim.model, step::MAX_CUTS)
+        );
+    }
     let mut progress = Progress::new(world, sim.total_steps());
     let mut last = opts.until_step.unwrap_or(u64::MAX).min(sim.total_steps());
     // The per-rank table after the end-of-run line: sizes of the last mesh, CPU of the solves.

@@ -65,7 +65,7 @@ impl Progress {
         let left =
             (self.total - step) as f64 * self.started.elapsed().as_secs_f64() / done.max(1.0);
         println!(
-            "step {step:>5}/{} load {:.4} newton {:>2}{} linear {} |R| {:.2e} particles {} triangles {} remapped {} | {} (contact {:.3}, augmentations {}) | step {:.3}s left {:.0}s",
+            "step {step:>5}/{} load {:.4} newton {:>2}{} linear {} |R| {:.2e} particles {} triangles {} remapped {} | {} (contact {:.3}, contact switches {}) | step {:.3}s left {:.0}s",
             self.total,
             sim.load_factor(),
             r.newton_iterations,
@@ -77,7 +77,7 @@ impl Progress {
             r.remapped,
             phases.join(" "),
             r.contact_seconds,
-            r.augmentations,
+            r.contact_switches,
             t.total(),
             left
         );

@@ -34,8 +34,8 @@ pub struct Simulation {
     pub(super) crossing: std::cell::RefCell<Vec<usize>>,
     /// Contact pressure and shear per contact node of the last increment.
     pub(super) last_contact: std::cell::RefCell<super::contact::ContactState>,
-    /// Contact augmentations (Newton solves after the first) since the last step report.
-    pub(super) augmentations: std::cell::Cell<u64>,
+    /// Contact status changes between Newton iterations since the last step report.
+    pub(super) contact_switches: std::cell::Cell<u64>,
     /// The current piece is being retried with the other line search.
     pub(super) alternate_search: std::cell::Cell<bool>,
     /// Seconds spent on contact since the last step report.
@@ -66,8 +66,9 @@ pub struct StepReport {
     pub remapped: u64,
     pub particles: u64,
     pub triangles: u64,
-    /// Contact augmentations (Newton solves after the first) in the step, all ranks.
-    pub augmentations: usize,
+    /// Contact status changes (touching, sticking, slipping) between the step's Newton
+    /// iterations, all ranks.
+    pub contact_switches: usize,
     /// Deepest particle penetration into a rigid body, as a fraction of its spacing.
     pub penetration: f64,
     /// Seconds of the step spent on contact (part of the solve phase); 0 without bodies.
@@ -116,7 +117,7 @@ impl Simulation {
             last_body_force: Vec::new(),
             crossing: Default::default(),
             last_contact: Default::default(),
-            augmentations: Default::default(),
+            contact_switches: Default::default(),
             contact_seconds: Default::default(),
             alternate_search: Default::default(),
             solver: Default::default(),

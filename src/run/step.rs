@@ -9,7 +9,7 @@ use crate::petsc::linear::{p_multigrid_from_options, upper_triangle_smoother_fro
 use crate::petsc::{
     IndexSet, LinearSolver, Mat, NullSpace, PVec, Petsc, PetscError, Snes, SolveFailure,
 };
-use crate::scene::{LineSearch, LinearChoice};
+use crate::scene::LinearChoice;
 use crate::solve::interpolation::{Interpolation, InterpolationMap};
 use crate::solve::nullspace::orthonormal_rigid_body_modes;
 use crate::solve::pmg::CoarseSpace;
@@ -120,7 +120,8 @@ fn pattern_signature(dofs: &DofMap) -> u64 {
 pub enum SolveError {
     /// Newton did not converge: a smaller increment may.
     Diverged(String),
-    /// The contact pressures did not settle within `contact.max_augmentations` solves: a
+    /// Newton converged with a contact node off the body's face by more than
+    /// `contact.tolerance` of its spacing (a touching node held off it, a free one inside): a
     /// smaller increment may settle them.
     ContactUnsettled(String),
     Fatal(String),
@@ -160,8 +161,8 @@ pub struct Solved {
     /// Krylov iterations of the increment's linear solves (1 per Newton iteration when direct).
     linear_iterations: usize,
     residual_norm: f64,
-    /// Newton solves after the first (contact augmentations), all ranks.
-    augmentations: usize,
+    /// Contact status changes between Newton iterations, all ranks.
+    contact_switches: usize,
 }
 
 /// The converged increment.
@@ -175,7 +176,7 @@ struct Outcome {
     body_force: Vec<[f64; 2]>,
     contact_state: super::contact::ContactState,
     stats: crate::petsc::SolveStats,
-    augmentations: usize,
+    contact_switches: usize,
 }
 
 /// Global identity of local node `n`: a vertex's particle id twice, or an edge's two particle
@@ -306,8 +307,8 @@ impl Simulation {
             }
         }
         let clock = std::time::Instant::now();
-        let loads = self.boundary_loads(mesh, &dofs, from, to);
-        self.add_contact_time(clock);
+        let loads = self.boundary_loads(mesh, &dofs, &constraints, from, to);
+        self.add_contact_seconds(clock.elapsed().as_secs_f64());
         self.check_surface_selection(world, &loads.surface_edges, step)?;
         let spacing = loads.spacing;
         let setup = StepSetup {
@@ -348,7 +349,7 @@ impl Simulation {
             newton_iterations: o.stats.newton_iterations,
             linear_iterations: o.stats.linear_iterations,
             residual_norm: o.stats.residual_norm,
-            augmentations: o.augmentations,
+            contact_switches: o.contact_switches,
         })
     }
 
@@ -375,21 +376,8 @@ impl Simulation {
         drop(cached);
         let x = PVec::mpi(world, dofs.n_owned_dofs)?;
         let solver = &self.model.scene.solver;
-        let line_search = match solver.line_search {
-            LineSearch::Auto if self.model.plastic() => "bt",
-            LineSearch::Auto | LineSearch::Basic => "basic",
-            LineSearch::Bt => "bt",
-            LineSearch::L2 => "l2",
-            LineSearch::Cp => "cp",
-        };
-        // The retry after a divergence: full steps if the line search backtracked, else
-        // backtracking. Backtracking can stall at a kink of the plastic or contact response that
-        // a full step jumps over, and a full step can overshoot where backtracking does not.
-        let line_search = match (alternate, line_search) {
-            (false, ls) => ls,
-            (true, "bt") => "basic",
-            (true, _) => "bt",
-        };
+        let line_search =
+            super::step_solver::StepSolver::of(&self.model, MAX_CUTS).line_search(alternate);
         let iterative = match solver.linear {
             LinearChoice::Direct => false,
             LinearChoice::Iterative => true,
@@ -660,49 +648,8 @@ impl Simulation {
                 SolveFailure::Failed(e) => SolveError::Fatal(format!("step {step}: {}", e.message)),
             })
         };
-        let mut stats = newton(&mut problem, x, jac)?;
-        // Augmented Lagrangian: re-solve with the multipliers set to the converged pressures
-        // until they settle (every rank agrees through the reductions).
-        let contact = &self.model.scene.contact;
-        let mut augmentations = 0;
-        // A multiplier change below this (Pa) counts as settled for stiffening: a tenth of the
-        // tolerance at the last solve's largest pressure.
-        let mut settled = 0.0;
-        let clock = std::time::Instant::now();
-        if !self.model.bodies.is_empty()
-            && sum_f64(world, &[problem.contact_pairs().len() as f64])[0] > 0.0
-        {
-            loop {
-                let local = problem
-                    .local_values(x.as_ref())
-                    .map_err(|e| err(e.to_string()))?;
-                // Past half the allowed solves the active set is kept, so that nodes that keep
-                // entering and leaving it cannot stop the step.
-                let switch = 2 * (augmentations + 1) < contact.max_augmentations as usize;
-                let a = problem.augment(&local, spacing, switch, settled);
-                let change = max_f64(world, a.change);
-                let pressure = max_f64(world, a.pressure);
-                settled = 0.1 * contact.tolerance * pressure;
-                let switched = sum_f64(world, &[a.switched as f64])[0];
-                if switched == 0.0 && change <= contact.tolerance * pressure {
-                    break;
-                }
-                if augmentations + 1 >= contact.max_augmentations as usize {
-                    return Err(SolveError::ContactUnsettled(format!(
-                        "step {step}: contact did not settle in {} Newton solves ({switched} \
-                         nodes still changing contact, pressures by {:.1e} relative)",
-                        contact.max_augmentations,
-                        change / pressure.max(f64::MIN_POSITIVE)
-                    )));
-                }
-                augmentations += 1;
-                let more = newton(&mut problem, x, jac)?;
-                stats.newton_iterations += more.newton_iterations;
-                stats.linear_iterations += more.linear_iterations;
-                stats.residual_norm = more.residual_norm;
-            }
-        }
-        self.add_contact_time(clock);
+        let stats = newton(&mut problem, x, jac)?;
+        self.add_contact_seconds(problem.contact_seconds());
         // An iterative solver is not kept for the next increment (see `solve`): its hierarchy
         // and vectors are freed now, before the converged state's element pass.
         if iterative {
@@ -730,19 +677,17 @@ impl Simulation {
         };
         let reaction = problem.reaction(&converged, driven);
         let set_reactions = self.set_reactions(mesh, dofs, &problem, &converged, from);
+        let laws = problem.contact_laws(&local);
+        self.check_contact_gaps(world, problem.contact_pairs(), &laws, spacing, step)?;
         let mut body_force = vec![[0.0; 2]; self.model.bodies.len()];
         let mut contact_state = super::contact::ContactState::new();
-        for (c, f) in problem
-            .contact_pairs()
-            .iter()
-            .zip(problem.contact_forces(&local))
-        {
+        for (c, law) in problem.contact_pairs().iter().zip(&laws) {
             let b = &mut body_force[c.body as usize];
-            b[0] -= f.force[0];
-            b[1] -= f.force[1];
-            if c.active {
+            b[0] -= law.force[0];
+            b[1] -= law.force[1];
+            if law.status != crate::rigid::Status::Free {
                 let key = node_key(mesh, dofs, c.node as usize);
-                contact_state.insert((key, c.body), [f.pressure, f.shear]);
+                contact_state.insert((key, c.body), [law.pressure, law.shear]);
             }
         }
         let du = problem.node_displacements(&local);
@@ -758,7 +703,7 @@ impl Simulation {
             body_force,
             contact_state,
             stats,
-            augmentations,
+            contact_switches: sum_f64(world, &[problem.contact_switches() as f64])[0] as usize,
         })
     }
 
@@ -841,8 +786,8 @@ impl Simulation {
         self.last_set_reactions = solved.set_reactions;
         self.last_body_force = solved.body_force;
         *self.last_contact.borrow_mut() = solved.contact_state;
-        self.augmentations
-            .set(self.augmentations.get() + solved.augmentations as u64);
+        self.contact_switches
+            .set(self.contact_switches.get() + solved.contact_switches as u64);
         self.last_area = owned_area(mesh, &solved.du, &solved.dofs);
         if completes {
             self.header.step += 1;
@@ -881,15 +826,15 @@ impl Simulation {
 }
 
 impl Simulation {
-    /// Time spent on contact: finding pairs and the Newton solves of the augmentations.
-    fn add_contact_time(&self, since: std::time::Instant) {
+    /// Time spent on contact: finding the pairs and evaluating their laws.
+    fn add_contact_seconds(&self, seconds: f64) {
         self.contact_seconds
-            .set(self.contact_seconds.get() + since.elapsed().as_secs_f64());
+            .set(self.contact_seconds.get() + seconds);
     }
 }
 
 /// Halvings of a step's increment before a Newton failure is final.
-const MAX_CUTS: usize = 6;
+pub(super) const MAX_CUTS: usize = 6;
 
 impl Simulation {
     /// Collective. Solves the next step on `mesh` and moves the particles. When Newton diverges,
@@ -962,7 +907,7 @@ impl Simulation {
                         report.newton_iterations = newton;
                         report.linear_iterations = linear;
                         report.remapped = remapped;
-                        report.augmentations = self.augmentations.take() as usize;
+                        report.contact_switches = self.contact_switches.take() as usize;
                         report.contact_seconds = self.contact_seconds.take();
                         report.cuts = cuts;
                         return Ok(report);
@@ -1046,7 +991,7 @@ impl Simulation {
             linear_iterations: counts[1],
             cuts: counts[2],
             remapped: counts[3] as u64,
-            augmentations: self.augmentations.take() as usize,
+            contact_switches: self.contact_switches.take() as usize,
             contact_seconds: self.contact_seconds.take(),
             collapse: Some(bracket),
             ..self.last_report(world, mesh)

@@ -134,9 +134,9 @@ fn check_contact(s: &Scene) -> Result<(), Invalid> {
         return fail(
             c.join("penalty"),
             format!(
-                "must be from {:e} to {:e} (got {penalty:e}; default 1000): softer, the pressures \
-                 take many more solves to settle; stiffer, the tangent is too ill-conditioned \
-                 for an accurate force",
+                "must be from {:e} to {:e} (got {penalty:e}; default 1): the constant that weighs \
+                 a contact node's pressure against its gap while Newton decides whether it \
+                 touches; far above 1, sticking nodes flip between slipping either way",
                 PENALTY.0, PENALTY.1
             ),
         );
@@ -149,16 +149,6 @@ fn check_contact(s: &Scene) -> Result<(), Invalid> {
                 "must be from {:e} to {} (got {tolerance:e}; default 1e-6): below, round-off \
                  keeps the pressures from settling; above, the force is off (by 41 % at 0.5)",
                 TOLERANCE.0, TOLERANCE.1
-            ),
-        );
-    }
-    if s.contact.max_augmentations < 2 {
-        return fail(
-            c.join("max_augmentations"),
-            format!(
-                "must be >= 2 (got {}; default 12): the first solve's pressures are settled only \
-                 when a second confirms them",
-                s.contact.max_augmentations
             ),
         );
     }

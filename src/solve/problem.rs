@@ -17,7 +17,7 @@ use crate::mesh::LocalMesh;
 use crate::petsc::matrix::{to_int, MatRef};
 use crate::petsc::snes::{CallbackError, NonlinearProblem};
 use crate::petsc::{Int, Mat, PVec, PetscError, Scatter, VecRef};
-use crate::rigid::{pair_force, ContactPair, PairForce, Shape};
+use crate::rigid::{node_law, ContactPair, NodeLaw, Shape, Status};
 use pfem_partition::{agree_on_error, Comm};
 use std::cell::{Cell, RefCell};
 
@@ -69,19 +69,6 @@ impl StepSetup<'_> {
     }
 }
 
-/// What an augmentation of the contact multipliers changed (this rank's share).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Augmentation {
-    /// Largest change of a node's multiplier (Pa).
-    pub change: f64,
-    /// Largest contact pressure (Pa).
-    pub pressure: f64,
-    /// Largest penetration as a fraction of the node's spacing.
-    pub penetration: f64,
-    /// Nodes that entered or left the active set.
-    pub switched: usize,
-}
-
 /// One element's contribution: residual, row-major tangent (empty where only the residual and
 /// states were asked for), states; dof order as the element's.
 pub struct ElementResult {
@@ -127,8 +114,7 @@ pub struct StepProblem<'a> {
     /// for the Jacobian at the iterate whose residual it has just evaluated, and the converged
     /// state is read at the last residual's iterate: each evaluation there was a second full
     /// pass over the elements (measured on the cantilever at h = 1/32: 75 element passes for
-    /// 35 Newton iterations, now 40). The elements do not depend on the contact multipliers
-    /// (`augment`), so a hit is exact.
+    /// 35 Newton iterations, now 40).
     /// Kept only with `keep_elements`: on the iterative path the tangents of every triangle
     /// (1.2 kB each, 3 kB per particle) would sit beside the AMG hierarchy and the Krylov
     /// vectors at the memory peak, so there the Jacobian evaluates the elements again and
@@ -138,7 +124,20 @@ pub struct StepProblem<'a> {
     /// Where the linear solver asks for the yielded zone: the global displacement dofs of the
     /// owned triangles with a Gauss point that yields at the last Jacobian's iterate.
     yielded: Option<RefCell<Vec<usize>>>,
+    /// The contact pair of each local node (`NO_PAIR` for none), and the triangles around the
+    /// contact nodes, whose residuals make the soil's force at them.
+    pair_of_node: Vec<u32>,
+    contact_tris: Vec<usize>,
+    /// The contact statuses at the last Jacobian, and how many changed between Jacobians (the
+    /// active set's and stick/slip's settling over the Newton iterations).
+    statuses: RefCell<Vec<Status>>,
+    switches: Cell<usize>,
+    /// Seconds spent on the contact laws.
+    contact_seconds: Cell<f64>,
 }
+
+/// No contact pair at a node.
+const NO_PAIR: u32 = u32::MAX;
 
 /// The pressure mass matrix scaled by −1/G that a Schur-complement preconditioner uses, and
 /// each local pressure unknown's row in it ([`DofMap::pressure_unknown`]).
@@ -170,6 +169,17 @@ impl<'a> StepProblem<'a> {
         if dofs.n_global_dofs > 0 {
             to_int(dofs.n_global_dofs - 1, "dof")?;
         }
+        let mut pair_of_node = vec![NO_PAIR; dofs.n_nodes()];
+        for (i, c) in setup.contact.iter().enumerate() {
+            pair_of_node[c.node as usize] = i as u32;
+        }
+        let contact_tris = (0..dofs.tri_nodes.len())
+            .filter(|&t| {
+                dofs.tri_nodes[t]
+                    .iter()
+                    .any(|&n| pair_of_node[n as usize] != NO_PAIR)
+            })
+            .collect();
         Ok(StepProblem {
             comm,
             mesh,
@@ -185,6 +195,11 @@ impl<'a> StepProblem<'a> {
             cache: RefCell::new(None),
             keep_elements: true,
             yielded: None,
+            pair_of_node,
+            contact_tris,
+            statuses: RefCell::new(Vec::new()),
+            switches: Cell::new(0),
+            contact_seconds: Cell::new(0.0),
         })
     }
 
@@ -455,8 +470,8 @@ impl<'a> StepProblem<'a> {
         result.map_err(|e| format!("triangle {:?}: {e}", self.mesh.tri_key(t)))
     }
 
-    /// Collective. Hands every local triangle at `x`, in order, to `each` (the cached results
-    /// when the last residual was evaluated at `x`), with the local vector. A failing element
+    /// Collective. Hands every local triangle at the local vector `local`, in order, to `each` (the cached results
+    /// when the last residual was evaluated there), and returns `local`. A failing element
     /// or `each` stops the pass, and all ranks learn of it, so they fail together and of the
     /// same kind (`each` may then have seen only some triangles). The first evaluation of the
     /// increment also fixes the constrained diagonal. For the residual (`jacobian` false) the
@@ -464,13 +479,10 @@ impl<'a> StepProblem<'a> {
     /// computed only where they are read.
     fn evaluate(
         &self,
-        x: VecRef<'_>,
+        local: Vec<f64>,
         jacobian: bool,
         mut each: impl FnMut(usize, &ElementResult) -> Result<(), CallbackError>,
     ) -> Result<Vec<f64>, CallbackError> {
-        let local = self
-            .local_values(x)
-            .map_err(|e| CallbackError::Fatal(e.to_string()))?;
         let first = self.diagonal.get().is_none();
         let store = !jacobian && self.keep_elements;
         let tangent = jacobian || first || store;
@@ -575,95 +587,87 @@ impl<'a> StepProblem<'a> {
         [local[o], local[o + 1]]
     }
 
-    /// Every contact pair evaluated at `local`.
-    pub fn contact_forces(&self, local: &[f64]) -> Vec<PairForce> {
-        let s = &self.setup;
-        s.contact
-            .iter()
-            .map(|c| {
-                pair_force(
-                    c,
-                    &s.bodies[c.body as usize],
-                    self.node_u(local, c.node as usize),
-                )
-            })
-            .collect()
-    }
-
     /// The contact pairs of this increment.
     pub fn contact_pairs(&self) -> &[ContactPair] {
         &self.setup.contact
     }
 
-    /// Updates the active set and the augmented multipliers from the solution `local`:
-    /// λ ← max(−suction, λ − ε g); a node in the set stays while that exceeds −suction, one
-    /// outside enters when it is positive. Suction holds soil that touches the body: letting it
-    /// take nodes in across a gap made an ambient pressure of 1e300 pull in every node near the
-    /// body (fx = −15 854 N where 0 and 1e5 give 26). `spacing` is each pair's node
-    /// spacing, to report the penetration relative to it.
-    /// With `switch` false the active set is kept (only the multipliers change): the last
-    /// resort when nodes keep entering and leaving it.
-    /// `settled` (Pa) is the change below which a multiplier counts as settled
-    /// ([`ContactPair::stiffen_if_stalled`]).
-    pub fn augment(
-        &mut self,
-        local: &[f64],
-        spacing: &[f64],
-        switch: bool,
-        settled: f64,
-    ) -> Augmentation {
-        let forces = self.contact_forces(local);
-        let mut a = Augmentation::default();
-        for ((c, f), h) in self.setup.contact.iter_mut().zip(&forces).zip(spacing) {
-            let p = f.pressure.max(-c.suction);
-            let change = (p - c.multiplier).abs();
-            a.change = a.change.max(change);
-            c.stiffen_if_stalled(change, settled);
-            // The scale of the pressures, not their distance from the suction floor (which
-            // an ambient pressure of 1e300 made the scale, so that anything settled).
-            a.pressure = a.pressure.max(p.abs());
-            a.penetration = a.penetration.max(-f.gap / h);
-            let floor = if c.active { -c.suction } else { 0.0 };
-            let active = f.pressure > floor;
-            if switch && active != c.active {
-                a.switched += 1;
-                c.active = active;
-            }
-            if c.shear_limit > 0.0 {
-                // A sticking node slips once its stick shear passes α·cu; a slipping one sticks
-                // again when it slides back against its slip (a slipping solve overshoots the
-                // trial shear, so that is not the test).
-                let slip = if !c.active {
-                    0
-                } else if c.slip == 0 {
-                    if f.shear_trial.abs() <= c.shear_limit {
-                        0
-                    } else {
-                        f.shear_trial.signum() as i8
-                    }
-                } else if f.slip * f64::from(c.slip) > 0.0 {
-                    c.slip
-                } else {
-                    0
-                };
-                if switch && slip != c.slip {
-                    a.switched += 1;
-                    c.slip = slip;
+    /// The contact law of every pair at `local` ([`node_law`]), from the soil's residual at
+    /// its node: the triangles around the contact nodes, in increasing order as the full pass
+    /// adds them, then the surface pressures and point loads. Every residual and Jacobian at
+    /// one iterate so decides alike. A triangle that cannot be evaluated is left out: the full
+    /// pass over the elements meets it too and fails on every rank together.
+    pub fn contact_laws(&self, local: &[f64]) -> Vec<NodeLaw> {
+        let s = &self.setup;
+        if s.contact.is_empty() {
+            return Vec::new();
+        }
+        let clock = std::time::Instant::now();
+        let mut r = vec![[0.0; 2]; s.contact.len()];
+        for &t in &self.contact_tris {
+            let Ok(e) = self.evaluate_element(t, local, false) else {
+                continue;
+            };
+            for (a, &n) in self.dofs.tri_nodes[t].iter().enumerate() {
+                let pair = self.pair_of_node[n as usize];
+                if pair != NO_PAIR {
+                    r[pair as usize][0] += e.residual[2 * a];
+                    r[pair as usize][1] += e.residual[2 * a + 1];
                 }
             }
-            c.multiplier = p;
         }
-        a
+        self.loads(local, |n, c, v| {
+            let pair = self.pair_of_node[n];
+            if pair != NO_PAIR {
+                r[pair as usize][c] -= v;
+            }
+        });
+        let laws = s
+            .contact
+            .iter()
+            .zip(&r)
+            .map(|(c, &r)| {
+                node_law(
+                    c,
+                    &s.bodies[c.body as usize],
+                    self.node_u(local, c.node as usize),
+                    r,
+                )
+            })
+            .collect();
+        self.contact_seconds
+            .set(self.contact_seconds.get() + clock.elapsed().as_secs_f64());
+        laws
     }
 
-    /// Adds the external forces of contact and surface pressure at `local` to `out` (owned,
-    /// free rows), with `sign` −1 for the residual.
-    fn external(&self, local: &[f64], mut add: impl FnMut(usize, usize, f64)) {
-        for (c, f) in self.setup.contact.iter().zip(self.contact_forces(local)) {
-            for (k, v) in f.force.iter().enumerate() {
-                add(c.node as usize, k, *v);
-            }
+    /// Seconds this problem spent on the contact laws.
+    pub fn contact_seconds(&self) -> f64 {
+        self.contact_seconds.get()
+    }
+
+    /// How many contact statuses (touching, sticking, slipping) changed from one Jacobian to
+    /// the next: the active set's settling.
+    pub fn contact_switches(&self) -> usize {
+        self.switches.get()
+    }
+
+    /// Notes the statuses of a Jacobian's laws, counting those that changed since the last.
+    fn note_statuses(&self, laws: &[NodeLaw]) {
+        let mut last = self.statuses.borrow_mut();
+        if last.len() == laws.len() {
+            let changed = last
+                .iter()
+                .zip(laws)
+                .filter(|(a, l)| **a != l.status)
+                .count();
+            self.switches.set(self.switches.get() + changed);
         }
+        *last = laws.iter().map(|l| l.status).collect();
+    }
+
+    /// The external forces other than contact at `local`, as (local node, component, force):
+    /// surface pressures, then point loads.
+    fn loads(&self, local: &[f64], mut add: impl FnMut(usize, usize, f64)) {
         for (nodes, p) in &self.setup.surface {
             let x = nodes.map(|n| self.node_position(local, n as usize));
             let load = edge_pressure(x, *p);
@@ -671,6 +675,11 @@ impl<'a> StepProblem<'a> {
                 for k in 0..2 {
                     add(n as usize, k, load.force[2 * j + k]);
                 }
+            }
+        }
+        for &(n, force) in &self.setup.point_loads {
+            for (c, fc) in force.iter().enumerate() {
+                add(n as usize, c, *fc);
             }
         }
     }
@@ -719,23 +728,24 @@ impl<'a> StepProblem<'a> {
 }
 
 impl StepProblem<'_> {
-    /// −d(external force)/du of contact and surface pressure, on owned free rows, as
-    /// (global row, global column, value).
+    /// −d(surface pressure)/du, and the contact laws' own terms at their nodes (`local` of
+    /// [`NodeLaw`]), on owned free rows, as (global row, global column, value).
     fn external_tangent(
         &self,
         local: &[f64],
+        laws: &[NodeLaw],
         mut add: impl FnMut(Int, Int, f64) -> Result<(), PetscError>,
     ) -> Result<(), PetscError> {
         let g = |n: usize, c: usize| to_int(self.dofs.node_global[n] + c, "dof");
         // A prescribed column adds an explicit zero: the matrix keeps one pattern, and the
         // constrained rows and columns stay symmetric.
         let fixed = |n: usize, k: usize| self.setup.constraints.is_fixed(n, k);
-        for (c, f) in self.setup.contact.iter().zip(self.contact_forces(local)) {
+        for (c, law) in self.setup.contact.iter().zip(laws) {
             let n = c.node as usize;
             for i in 0..2 {
                 if self.free(n, i) {
                     for k in 0..2 {
-                        let v = if fixed(n, k) { 0.0 } else { -f.tangent[i][k] };
+                        let v = if fixed(n, k) { 0.0 } else { law.local[i][k] };
                         add(g(n, i)?, g(n, k)?, v)?;
                     }
                 }
@@ -764,6 +774,40 @@ impl StepProblem<'_> {
         }
         Ok(())
     }
+
+    /// Triangle `t`'s row-major `tangent` with the rows of its contact nodes taken through
+    /// their laws' transforms (borrowed unchanged where it has none).
+    fn contact_rows<'t>(
+        &self,
+        t: usize,
+        tangent: &'t [f64],
+        laws: &[NodeLaw],
+    ) -> std::borrow::Cow<'t, [f64]> {
+        let nodes = &self.dofs.tri_nodes[t];
+        if laws.is_empty()
+            || nodes
+                .iter()
+                .all(|&n| self.pair_of_node[n as usize] == NO_PAIR)
+        {
+            return std::borrow::Cow::Borrowed(tangent);
+        }
+        let width = self.dofs_per_element;
+        let mut out = tangent.to_vec();
+        for (a, &node) in nodes.iter().enumerate() {
+            let pair = self.pair_of_node[node as usize];
+            if pair == NO_PAIR {
+                continue;
+            }
+            let m = laws[pair as usize].transform;
+            let (rx, ry) = (2 * a * width, (2 * a + 1) * width);
+            for col in 0..width {
+                let (x, y) = (tangent[rx + col], tangent[ry + col]);
+                out[rx + col] = m[0][0] * x + m[0][1] * y;
+                out[ry + col] = m[1][0] * x + m[1][1] * y;
+            }
+        }
+        std::borrow::Cow::Owned(out)
+    }
 }
 
 /// Collective. The global mean of the diagonal entries whose rank-local sum and count are
@@ -781,10 +825,13 @@ fn positive_mean(comm: &Comm, sum_count: [f64; 2]) -> f64 {
 impl NonlinearProblem for StepProblem<'_> {
     fn residual(&mut self, x: VecRef<'_>, f: VecRef<'_>) -> Result<(), CallbackError> {
         let first = self.dofs.first_dof;
+        let local = self
+            .local_values(x)
+            .map_err(|e| CallbackError::Fatal(e.to_string()))?;
         let mut evaluated = Ok(Vec::new());
         f.write(|fa| {
             fa.fill(0.0);
-            evaluated = self.evaluate(x, false, |t, e| {
+            evaluated = self.evaluate(local, false, |t, e| {
                 for (k, r) in e.residual.iter().enumerate() {
                     if let Some(row) = self.free_row(t, k) {
                         fa[row] += r;
@@ -797,17 +844,20 @@ impl NonlinearProblem for StepProblem<'_> {
         let local = evaluated?;
         // Read after the evaluation: the first one of the increment fixes it.
         let diagonal = self.constrained_diagonal();
+        let laws = self.contact_laws(&local);
         f.write(|fa| {
-            self.external(&local, |n, c, v| {
+            self.loads(&local, |n, c, v| {
                 if self.free(n, c) {
                     fa[self.dofs.node_global[n] - first + c] -= v;
                 }
             });
-            for &(n, force) in &self.setup.point_loads {
-                let n = n as usize;
-                for (c, fc) in force.iter().enumerate() {
-                    if !self.setup.constraints.is_fixed(n, c) {
-                        fa[self.dofs.node_global[n] - first + c] -= fc;
+            // A contact node's rows are its law's: the soil's force there where it is free,
+            // the closed gap and the stick or slip condition where it touches.
+            for (c, law) in self.setup.contact.iter().zip(&laws) {
+                let n = c.node as usize;
+                for (k, v) in law.rows.iter().enumerate() {
+                    if self.free(n, k) {
+                        fa[self.dofs.node_global[n] - first + k] = *v;
                     }
                 }
             }
@@ -859,7 +909,10 @@ impl NonlinearProblem for StepProblem<'_> {
         if let Some(y) = yielded.as_mut() {
             y.clear();
         }
-        let evaluated = self.evaluate(x, true, |t, e| {
+        let local = self.local_values(x).map_err(fatal)?;
+        let laws = self.contact_laws(&local);
+        self.note_statuses(&laws);
+        let evaluated = self.evaluate(local, true, |t, e| {
             if let Some(y) = yielded.as_mut() {
                 // Each triangle once over the ranks: its owner lists it.
                 let start = self.setup.states_n.get(t);
@@ -897,6 +950,7 @@ impl NonlinearProblem for StepProblem<'_> {
                     .map_err(fatal)?;
             }
             let n = e.residual.len();
+            let tangent = self.contact_rows(t, &e.tangent, &laws);
             self.sorted_columns(t, &mut sorted_cols, &mut sorted_dofs);
             let (cols, order) = (&sorted_cols[..n], &sorted_dofs[..n]);
             // Prescribed columns are zeroed (not dropped, so the pattern stays): with the
@@ -912,7 +966,7 @@ impl NonlinearProblem for StepProblem<'_> {
                 jacobi_bound = jacobi_bound.max(element_jacobi_bound(&e.tangent, n, fixed));
             }
             let push_row = |vals: &mut Vec<f64>, k: usize| {
-                let row = &e.tangent[k * n..][..n];
+                let row = &tangent[k * n..][..n];
                 if fixed == 0 {
                     vals.extend(order.iter().map(|&c| row[c as usize]));
                 } else {
@@ -980,7 +1034,7 @@ impl NonlinearProblem for StepProblem<'_> {
             let bound = pfem_partition::max_f64(self.comm, jacobi_bound.max(1.0));
             self.jacobi_bound.set(Some(bound));
         }
-        self.external_tangent(&local, |r, c, v| j.add_values(&[r], &[c], &[v]))
+        self.external_tangent(&local, &laws, |r, c, v| j.add_values(&[r], &[c], &[v]))
             .map_err(fatal)?;
         let diagonal = self.constrained_diagonal();
         for (n, c, _) in self.setup.constraints.prescribed() {

@@ -1,0 +1,97 @@
+//! Contact solved inside Newton (issue 30): the same curve on any rank count, also through cut
+//! steps; few Newton iterations per step on a coarse rigid-body scene.
+
+mod common;
+use common::*;
+use std::path::Path;
+
+fn column(dir: &Path, out: &str, name: &str) -> Vec<f64> {
+    let (header, rows) = history(&dir.join(out).join("history.csv"));
+    let i = header.iter().position(|h| h == name).expect(name);
+    rows.iter().map(|r| r[i]).collect()
+}
+
+/// Total Newton iterations of a run, from its end-of-run line.
+fn newton_iterations(log: &str) -> usize {
+    let done = log
+        .lines()
+        .find(|l| l.starts_with("done:"))
+        .expect("an end-of-run line");
+    let words: Vec<&str> = done.split_whitespace().collect();
+    let at = words
+        .iter()
+        .position(|w| *w == "Newton")
+        .expect("Newton iterations in the end-of-run line");
+    words[at - 1].parse().expect("a count")
+}
+
+/// The coarse rough T-bar (D/4 at the bar), 4 steps of 0.025 D, with `sets`.
+fn rough_tbar(dir: &Path, sets: &[&str]) {
+    let mut args = vec![
+        "new",
+        "tbar-rough",
+        "-o",
+        "t.h5",
+        "--set",
+        "mesh.fine=[{origin=[0.0,0.26],size=[0.16,0.28],h=0.01}]",
+        "--set",
+        "rigid[0].stages=[{to=[0.0,-0.004],steps=4}]",
+    ];
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    ok(dir, 1, &args);
+}
+
+/// Every column of the histories of `outs` within `tol` relative of the first's.
+fn same_histories(dir: &Path, outs: &[String], tol: f64) {
+    for name in ["w_over_D", "Nc"] {
+        let first = column(dir, &outs[0], name);
+        for out in &outs[1..] {
+            let other = column(dir, out, name);
+            assert_eq!(first.len(), other.len(), "{out}: {name}");
+            for (a, b) in first.iter().zip(&other) {
+                assert!(
+                    (a - b).abs() <= tol * a.abs().max(1e-12),
+                    "{name}: {a} on 1 rank, {b} in {out}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn rough_tbar_same_curve_on_one_two_three_ranks() {
+    let dir = workdir("contact-newton-ranks");
+    rough_tbar(&dir, &[]);
+    let outs: Vec<String> = [1, 2, 3].iter().map(|r| format!("r{r}")).collect();
+    for (ranks, out) in [1, 2, 3].into_iter().zip(&outs) {
+        let log = ok(&dir, ranks, &["t.h5", "--out", out]);
+        let newton = newton_iterations(&log);
+        println!("{ranks} ranks: {newton} Newton iterations in 4 steps");
+        // Measured: 47 (22, 10, 9, 6) on 1 and 2 ranks; the first step starts from no
+        // predictor. The augmentation loop took 246 for twice these steps (30.8 a step).
+        assert!(newton <= 4 * 15, "{newton} Newton iterations");
+    }
+    println!("Nc: {:?}", column(&dir, "r1", "Nc"));
+    // Measured: 1 and 2 ranks agree to 1e-15; 3 ranks took 49 iterations and differ by
+    // 2.4e-6 at step 2 (the issue asks for 0.5 %).
+    same_histories(&dir, &outs, 1e-5);
+}
+
+#[test]
+fn a_cut_step_takes_the_same_path_on_one_and_two_ranks() {
+    let dir = workdir("contact-newton-cut");
+    // Too few Newton iterations for the first step whole (it takes 22): it is cut, on every
+    // rank count alike.
+    rough_tbar(&dir, &["solver.newton_max_it=12"]);
+    let outs: Vec<String> = [1, 2].iter().map(|r| format!("r{r}")).collect();
+    for (ranks, out) in [1, 2].into_iter().zip(&outs) {
+        let log = ok(&dir, ranks, &["t.h5", "--out", out]);
+        assert!(
+            log.contains("(cut "),
+            "a step was cut on {ranks} ranks:\n{log}"
+        );
+    }
+    same_histories(&dir, &outs, 1e-6);
+}
