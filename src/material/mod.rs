@@ -17,6 +17,7 @@ pub mod elastic;
 pub mod layout;
 pub mod placed;
 pub mod tresca;
+pub mod umat;
 
 pub use layout::{InternalVar, Rows, StateLayout, VarKind, STRESS_LEN};
 
@@ -107,6 +108,8 @@ pub enum MaterialError {
         /// Norm of the local residual at the last iterate.
         residual: f64,
     },
+    /// A plug-in model (a UMAT) failed or asked for a smaller step; the message names it.
+    Plugin(String),
 }
 
 impl fmt::Display for MaterialError {
@@ -131,6 +134,7 @@ impl fmt::Display for MaterialError {
                 "return mapping failed to converge after {iterations} iterations \
                  (residual {residual:e})"
             ),
+            Self::Plugin(message) => f.write_str(message),
         }
     }
 }

@@ -291,6 +291,8 @@ pub enum MaterialModel {
     LinearElastic,
     /// `"tresca"`: elastic-perfectly plastic with undrained shear strength `cu`.
     Tresca,
+    /// `"umat"`: an Abaqus UMAT in a shared library (`library`, `props`, `state_variables`).
+    Umat,
 }
 
 impl MaterialModel {
@@ -298,6 +300,7 @@ impl MaterialModel {
         match self {
             MaterialModel::LinearElastic => "linear-elastic",
             MaterialModel::Tresca => "tresca",
+            MaterialModel::Umat => "umat",
         }
     }
 }
@@ -396,6 +399,26 @@ pub struct Material {
     /// Level (m) below which `cu_gradient` applies; required with it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference_level: Option<f64>,
+    /// `"umat"` only: the shared library holding `umat_`, relative to the scene file (to the
+    /// working directory for a built-in scene); the resolved scene records it absolute.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub library: Option<String>,
+    /// `"umat"` only: PROPS, in the order the UMAT reads them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub props: Vec<f64>,
+    /// `"umat"` only: the number of PROPS the UMAT expects, checked against `props` when given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nprops: Option<usize>,
+    /// `"umat"` only: NSTATV, state variables per Gauss point, `statev_1 ...` unless named.
+    #[serde(default, skip_serializing_if = "is_zero_usize")]
+    pub state_variables: usize,
+    /// `"umat"` only: names of the state variables in outputs and checkpoints.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub state_names: Vec<String>,
+}
+
+fn is_zero_usize(n: &usize) -> bool {
+    *n == 0
 }
 
 fn is_zero(x: &f64) -> bool {
