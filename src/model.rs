@@ -5,13 +5,13 @@ use crate::material::elastic::LinearElastic;
 use crate::material::placed::{union_layout, Placed};
 use crate::material::tresca::{CuProfile, Tresca};
 use crate::material::umat::{self, Umat};
-use std::borrow::Cow;
-use std::path::Path;
 use crate::material::{InternalVar, Material, MaterialError, StateLayout};
 use crate::rigid::RigidBody;
 use crate::scene::{Axis, ElementChoice, Fixed, MaterialModel, Prescribed, Scene, Selection};
 use crate::solve::Kernel;
 use crate::solve::Law;
+use std::borrow::Cow;
+use std::path::Path;
 
 /// The internal variables of a scene material's model. They depend on the model alone (not on
 /// its parameters' values), so they are known before the parameters are checked.

@@ -93,9 +93,8 @@ pub fn check(m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
     }
     for (i, n) in names.iter().enumerate() {
         let ok = !n.is_empty() && n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-        let taken = STRESS_COLUMNS.contains(&n.as_str())
-            || n == umat::STRAN
-            || names[..i].contains(n);
+        let taken =
+            STRESS_COLUMNS.contains(&n.as_str()) || n == umat::STRAN || names[..i].contains(n);
         if !ok || taken {
             return fail(
                 mat.join("state_names").at(i),

@@ -3,8 +3,8 @@ C     tests: PROPS = (E, nu, cu). Yield on the largest in-plane shear stress,
 C     sqrt(((S11-S22)/2)**2 + S12**2) = cu, closed-form radial return in the in-plane
 C     deviator and its consistent tangent. STATEV(1:4) = plastic strain (11, 22, 33,
 C     engineering 12), STATEV(5) = accumulated equivalent plastic strain.
-C     PROPS(4) = 1 makes the first plastic call ask for a smaller step (PNEWDT = 0.5), for
-C     the test of step cutting.
+C     Optional PROPS(4), for the tests of failures: > 0, a plastic multiplier above it asks
+C     for a smaller step (PNEWDT = 0.5); < 0, a plastic call returns a NaN stress.
       SUBROUTINE UMAT(STRESS,STATEV,DDSDDE,SSE,SPD,SCD,
      1 RPL,DDSDDT,DRPLDE,DRPLDT,
      2 STRAN,DSTRAN,TIME,DTIME,TEMP,DTEMP,PREDEF,DPRED,CMNAME,
@@ -47,14 +47,18 @@ C     the test of step cutting.
       TAU = STRESS(4)
       R = SQRT(A*A + TAU*TAU)
       IF (R .LE. CU) RETURN
+      BETA = CU/R
+      DLAM = (R - CU)/G
       IF (NPROPS .GE. 4) THEN
-        IF (PROPS(4) .EQ. 1.D0) THEN
+        IF (PROPS(4) .GT. 0.D0 .AND. DLAM .GT. PROPS(4)) THEN
           PNEWDT = 0.5D0
           RETURN
         END IF
+        IF (PROPS(4) .LT. 0.D0) THEN
+          STRESS(1) = SQRT(-CU)
+          RETURN
+        END IF
       END IF
-      BETA = CU/R
-      DLAM = (R - CU)/G
       STRESS(1) = STRESS(1) - (1.D0 - BETA)*A
       STRESS(2) = STRESS(2) + (1.D0 - BETA)*A
       STRESS(4) = STRESS(4) - (1.D0 - BETA)*TAU

@@ -143,10 +143,7 @@ impl Umat {
         };
         self.lib.call(&mut c, &self.cmname);
         if c.pnewdt < 1.0 {
-            return Err(self.failure(format!(
-                "asks for a smaller step (PNEWDT = {})",
-                c.pnewdt
-            )));
+            return Err(self.failure(format!("asks for a smaller step (PNEWDT = {})", c.pnewdt)));
         }
         if c.stress.iter().any(|v| !v.is_finite()) {
             return Err(self.failure(format!("returned a non-finite STRESS {:?}", c.stress)));
