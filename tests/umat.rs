@@ -109,6 +109,48 @@ fn elastic_umat_gives_the_builtin_cantilever_history() {
 }
 
 #[test]
+fn a_umat_is_told_where_and_when_it_is_called() {
+    let dir = workdir("umat-site");
+    build_umat(&dir, "elastic");
+    small_cantilever(
+        &dir,
+        4,
+        &[
+            "material.model=umat",
+            "material.library=libelastic.so",
+            "material.props=[12.0e6, 0.2]",
+            "material.state_variables=7",
+            r#"material.state_names=["noel", "npt", "x", "y", "celent", "kinc", "time"]"#,
+        ],
+    );
+    ok(&dir, 2, &["c.h5", "--out", "out"]);
+    // Per Gauss point of the last step's triangles: NOEL, NPT, COORDS, CELENT, KINC, TIME.
+    let rows = h5py_rows(
+        &dir.join("out/checkpoints/step_000004.h5"),
+        "n = [x.decode() if isinstance(x, bytes) else x for x in f['gauss/state'].attrs['names']]\n\
+         s = f['gauss/state'][:]\n\
+         w = len(n)\n\
+         for row in s:\n\
+         \x20   for q in range(3):\n\
+         \x20       g = row[q * w:(q + 1) * w]\n\
+         \x20       print(*[g[n.index(k)] for k in ['noel', 'npt', 'x', 'y', 'celent', 'kinc', 'time']])",
+    );
+    assert!(!rows.is_empty());
+    for (i, r) in rows.iter().enumerate() {
+        assert!(r[0] >= 1.0, "NOEL {r:?}");
+        assert_eq!(r[1], (i % 3 + 1) as f64, "NPT {r:?}");
+        // The cantilever is 10 m x 1 m, bent upwards by its end load.
+        assert!(
+            (-0.1..=10.1).contains(&r[2]) && r[3] > -0.1 && r[3] < 8.0,
+            "COORDS {r:?}"
+        );
+        assert!(r[4] > 0.05 && r[4] < 1.0, "CELENT {r:?}");
+        assert_eq!(r[5], 4.0, "KINC {r:?}");
+        assert!((r[6] - 1.0).abs() < 1e-12, "TIME + DTIME {r:?}");
+    }
+}
+
+#[test]
 fn tresca_umat_holds_two_cu_and_checkpoints_its_state_by_name() {
     let dir = workdir("umat-tresca");
     build_umat(&dir, "tresca");

@@ -267,6 +267,7 @@ impl Simulation {
         let _ = petsc;
         let err = |e: String| SolveError::Fatal(e);
         let step = self.header.step + 1;
+        crate::material::umat::site::set_increment(step, from, to);
         let dofs =
             DofMap::build(world, mesh, self.model.mixed()).map_err(|e| err(e.to_string()))?;
         let constraints = Constraints::build(&dofs, |p| {

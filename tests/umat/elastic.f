@@ -1,5 +1,7 @@
 C     Plane-strain (or 3-D) isotropic linear elasticity as an Abaqus UMAT, for pfem-mpi's tests:
 C     PROPS(1) = E, PROPS(2) = nu. The stress increment is DDSDDE * DSTRAN (engineering shear).
+C     With NSTATV = 7 it records where and when it was called, for the test of the interface:
+C     NOEL, NPT, COORDS(1), COORDS(2), CELENT, KINC, TIME(1) + DTIME.
       SUBROUTINE UMAT(STRESS,STATEV,DDSDDE,SSE,SPD,SCD,
      1 RPL,DDSDDT,DRPLDE,DRPLDT,
      2 STRAN,DSTRAN,TIME,DTIME,TEMP,DTEMP,PREDEF,DPRED,CMNAME,
@@ -38,5 +40,14 @@ C     PROPS(1) = E, PROPS(2) = nu. The stress increment is DDSDDE * DSTRAN (engi
           STRESS(I) = STRESS(I) + DDSDDE(I,J)*DSTRAN(J)
         END DO
       END DO
+      IF (NSTATV .GE. 7) THEN
+        STATEV(1) = NOEL
+        STATEV(2) = NPT
+        STATEV(3) = COORDS(1)
+        STATEV(4) = COORDS(2)
+        STATEV(5) = CELENT
+        STATEV(6) = KINC
+        STATEV(7) = TIME(1) + DTIME
+      END IF
       RETURN
       END

@@ -21,15 +21,19 @@
 //!   checkpoints, halo exchange, mapping and output carry like any model's.
 //! - PNEWDT: set to 1e36 before the call; a value below 1 makes the step be cut (the call
 //!   fails as a Newton divergence does).
-//! - TIME = (0, 0), DTIME = 1, KSTEP = 1, KINC = 1, NOEL = NPT = 0, COORDS = 0, CELENT = 0,
-//!   LAYER = KSPT = 1; temperature and field variables 0: the material interface does not know
-//!   the step, the element or the position (yet), so a UMAT must not depend on them.
+//! - The analysis is one Abaqus step (KSTEP = 1) whose time is pfem-mpi's load factor: TIME(1) =
+//!   TIME(2) = the load factor at the start of the increment, DTIME its increment (a cut step's
+//!   piece), KINC = the step number. NOEL is the triangle's rank-local index + 1 (PFEM remeshes
+//!   every step, so element numbers identify nothing across steps or ranks), NPT = 1..3 the
+//!   Gauss point, COORDS its position at the start of the step, CELENT = √(2 × area) of the
+//!   triangle; LAYER = KSPT = 1; temperatures and field variables 0 (isothermal).
 //!
 //! A UMAT runs inside an MPI rank, once per Gauss point and Newton iteration, from the same
 //! state each iteration: it must not keep state between calls (SAVE variables, COMMON blocks),
 //! write files, call MPI, or STOP (which ends the rank, and with it the run).
 
 mod ffi;
+pub mod site;
 
 use std::borrow::Cow;
 use std::path::Path;
@@ -116,6 +120,11 @@ impl Umat {
         }
         let (stran, statev) = internal.split_at_mut(4);
         let identity = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+        let (inc, element) = site::take_call();
+        let (noel, npt, coords, celent) = match element {
+            Some((e, q)) => (e.number, q as i32 + 1, e.gauss[q], e.size),
+            None => (0, 0, [0.0; 2], 0.0),
+        };
         // Column-major 3x3: (1,2) and (2,1) are the two in-plane off-diagonals.
         let dfgrd1 = [u[0], u[3], 0.0, u[3], u[1], 0.0, 0.0, 0.0, u[2]];
         let mut c = ffi::Call {
@@ -127,19 +136,19 @@ impl Umat {
             scd: 0.0,
             stran: [stran[0], stran[1], stran[2], stran[3]],
             dstran: *dstran,
-            time: [0.0, 0.0],
-            dtime: 1.0,
+            time: [inc.time, inc.time],
+            dtime: inc.dtime,
             props: &self.props,
-            coords: [0.0; 3],
+            coords: [coords[0], coords[1], 0.0],
             drot: identity,
             pnewdt: PNEWDT_NONE,
-            celent: 0.0,
+            celent,
             dfgrd0: identity,
             dfgrd1,
-            noel: 0,
-            npt: 0,
+            noel,
+            npt,
             kstep: 1,
-            kinc: 1,
+            kinc: inc.step,
         };
         self.lib.call(&mut c, &self.cmname);
         if c.pnewdt < 1.0 {
