@@ -156,23 +156,31 @@ fn tresca_umat_holds_two_cu_and_checkpoints_its_state_by_name() {
     build_umat(&dir, "tresca");
     block_case(&dir, "ref.h5", &[]);
     block_case(&dir, "b.h5", &tresca_umat_sets(""));
-    ok(&dir, 2, &["ref.h5", "--out", "ref"]);
-    let log = ok(&dir, 2, &["b.h5", "--out", "out"]);
-    let (header, rows) = history(&dir.join("out/history.csv"));
-    assert_eq!(header[2], "stress_over_cu");
-    let worst = rows[1..]
-        .iter()
-        .map(|r| (r[2] - 2.0).abs() / 2.0)
-        .fold(0.0, f64::max);
-    let diff = history_difference(&dir.join("ref/history.csv"), &dir.join("out/history.csv"));
-    println!(
-        "Tresca UMAT, 2 ranks: stress/cu off 2 by {worst:.1e} once yielded; vs built-in {diff:.1e}"
-    );
-    // Plane-strain compression between smooth platens: σyy − σxx = 2cu exactly once yielded.
-    assert!(worst < 1e-6, "stress/cu off 2 by {worst:e}");
-    assert!(diff < 1e-8, "differs from the built-in tresca by {diff:e}");
-    assert!(!log.contains("(cut"), "no cut without PNEWDT:\n{log}");
-    let ckpt = dir.join("out/checkpoints/step_000010.h5");
+    for ranks in [1, 2] {
+        let (r, o) = (format!("ref{ranks}"), format!("out{ranks}"));
+        ok(&dir, ranks, &["ref.h5", "--out", &r]);
+        let log = ok(&dir, ranks, &["b.h5", "--out", &o]);
+        let (header, rows) = history(&dir.join(&o).join("history.csv"));
+        assert_eq!(header[2], "stress_over_cu");
+        let worst = rows[1..]
+            .iter()
+            .map(|r| (r[2] - 2.0).abs() / 2.0)
+            .fold(0.0, f64::max);
+        let diff = history_difference(
+            &dir.join(&r).join("history.csv"),
+            &dir.join(&o).join("history.csv"),
+        );
+        println!(
+            "Tresca UMAT, {ranks} ranks: stress/cu off 2 by {worst:.1e} once yielded; \
+             vs built-in {diff:.1e}"
+        );
+        // Plane-strain compression between smooth platens: σyy − σxx = 2cu exactly once
+        // yielded (from step 2).
+        assert!(worst < 1e-6, "stress/cu off 2 by {worst:e}");
+        assert!(diff < 1e-8, "differs from the built-in tresca by {diff:e}");
+        assert!(!log.contains("(cut"), "no cut without PNEWDT:\n{log}");
+    }
+    let ckpt = dir.join("out2/checkpoints/step_000010.h5");
     let names = h5py_rows(
         &ckpt,
         "n = [x.decode() if isinstance(x, bytes) else x for x in f['particles/state'].attrs['names']]\n\

@@ -28,6 +28,13 @@
 //!   Gauss point, COORDS its position at the start of the step, CELENT = √(2 × area) of the
 //!   triangle; LAYER = KSPT = 1; temperatures and field variables 0 (isothermal).
 //!
+//! Which element: a UMAT with state variables counts as inelastic ([`Material::yields`]), so
+//! `solver.element = "auto"` gives it the P2–P1 element, as for Tresca clay; one without, the P2
+//! element. The P2–P1 element takes only the deviator of the returned stress and tangent: the
+//! pressure is its own field, with the bulk modulus of the material's `young` and `poisson`
+//! (which a UMAT material therefore still gives, matching its elastic constants). A UMAT whose
+//! volumetric response matters (pressure-dependent, dilatant) needs `solver.element = "p2"`.
+//!
 //! A UMAT runs inside an MPI rank, once per Gauss point and Newton iteration, from the same
 //! state each iteration: it must not keep state between calls (SAVE variables, COMMON blocks),
 //! write files, call MPI, or STOP (which ends the rank, and with it the run).
