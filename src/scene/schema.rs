@@ -377,9 +377,10 @@ pub struct Material {
     /// The name zones give in `material = "..."`; required with several materials.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
-    /// `"linear-elastic"` or `"tresca"`.
+    /// `"linear-elastic"`, `"tresca"` or `"umat"`.
     pub model: MaterialModel,
-    /// Young's modulus (Pa), > 0.
+    /// Young's modulus (Pa), > 0. For `"umat"` the elastic constants the element and contact
+    /// take their pressure law and stiffness scale from (the UMAT's own, in `props`, should agree).
     pub young: f64,
     /// Poisson's ratio, -1 < poisson < 0.5.
     pub poisson: f64,
