@@ -180,6 +180,16 @@ fn tresca_umat_holds_two_cu_and_checkpoints_its_state_by_name() {
         assert!(diff < 1e-8, "differs from the built-in tresca by {diff:e}");
         assert!(!log.contains("(cut"), "no cut without PNEWDT:\n{log}");
     }
+    // The state variables come back from a checkpoint: a restart at step 5 ends where the
+    // straight run does.
+    ok(&dir, 1, &["b.h5", "--out", "split", "--until-step", "5"]);
+    ok(&dir, 1, &["split/checkpoints/step_000005.h5"]);
+    let diff = history_difference(
+        &dir.join("out1/history.csv"),
+        &dir.join("split/history.csv"),
+    );
+    println!("Tresca UMAT restarted at step 5: history differs by {diff:.1e}");
+    assert!(diff < 1e-12, "restart differs by {diff:e}");
     let ckpt = dir.join("out2/checkpoints/step_000010.h5");
     let names = h5py_rows(
         &ckpt,
