@@ -6,6 +6,7 @@ use crate::material::elastic::LinearElastic;
 use crate::material::mohr_coulomb::MohrCoulomb;
 use crate::material::placed::{union_layout, Placed};
 use crate::material::tresca::{CuProfile, Tresca};
+use crate::material::umat::{self, Umat};
 use crate::material::{InternalVar, Material, MaterialError, StateLayout};
 use crate::rigid::RigidBody;
 use crate::scene::{
@@ -14,11 +15,13 @@ use crate::scene::{
 use crate::solve::Kernel;
 use crate::solve::Law;
 use crate::solve::Pressure;
+use std::borrow::Cow;
+use std::path::Path;
 
 /// The internal variables of a scene material's model. They depend on the model alone (not on
 /// its parameters' values), so they are known before the parameters are checked.
-fn model_variables(m: &crate::scene::Material) -> &'static [InternalVar] {
-    match m.model {
+fn model_variables(m: &crate::scene::Material) -> Cow<'static, [InternalVar]> {
+    Cow::Borrowed(match m.model {
         MaterialModel::LinearElastic => &[],
         MaterialModel::Tresca if m.cu_gradient != 0.0 => {
             &crate::material::tresca::VARIABLES_WITH_CU
@@ -27,13 +30,23 @@ fn model_variables(m: &crate::scene::Material) -> &'static [InternalVar] {
         MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager => {
             &crate::material::mohr_coulomb::VARIABLES
         }
+        MaterialModel::Umat => return Cow::Owned(umat::variables(&umat_state_names(m))),
+    })
+}
+
+/// The names of a UMAT material's state variables: `state_names`, or `statev_1 ...`.
+fn umat_state_names(m: &crate::scene::Material) -> Vec<String> {
+    match m.state_names.is_empty() {
+        true => umat::default_names(m.state_variables),
+        false => m.state_names.clone(),
     }
 }
 
 /// The layout of the state rows of a scene: what case files, checkpoints and output hold per
 /// particle and Gauss point. With several materials, the union of their variables.
 pub fn state_layout(scene: &Scene) -> StateLayout {
-    union_layout(scene.material.all().iter().map(model_variables))
+    let vars: Vec<_> = scene.material.all().iter().map(model_variables).collect();
+    union_layout(vars.iter().map(|v| v.as_ref()))
 }
 
 /// The constitutive models of a scene, in its `[[material]]` order, their parameters checked;
@@ -43,10 +56,14 @@ pub fn materials_of(scene: &Scene) -> Result<Vec<Box<dyn Material>>, String> {
     let layout = state_layout(scene);
     let mut out = Vec::with_capacity(all.len());
     for (i, m) in all.iter().enumerate() {
-        let model = material_of(m).map_err(|e| match all.len() {
-            1 => format!("material: {e}"),
-            _ => format!("material[{i}]: {e}"),
-        })?;
+        let at = match all.len() {
+            1 => "material".to_string(),
+            _ => format!("material[{i}]"),
+        };
+        let model = match m.model {
+            MaterialModel::Umat => umat_of(m).map_err(|e| format!("{at}.library: {e}"))?,
+            _ => material_of(m).map_err(|e| format!("{at}: {e}"))?,
+        };
         out.push(match all.len() {
             1 => model,
             _ => Box::new(Placed::new(model, &layout)?) as Box<dyn Material>,
@@ -94,6 +111,7 @@ fn material_of(m: &crate::scene::Material) -> Result<Box<dyn Material>, Material
             };
             Box::new(DruckerPrager::new(m.young, m.poisson, c, phi, psi, fit)?)
         }
+        MaterialModel::Umat => umat_of(m).map_err(MaterialError::Plugin)?,
     })
 }
 
@@ -101,6 +119,16 @@ fn material_of(m: &crate::scene::Material) -> Result<Box<dyn Material>, Material
 /// the model rejects by name).
 fn strength(m: &crate::scene::Material) -> [f64; 3] {
     [m.cohesion, m.friction_angle, m.dilation_angle].map(|v| v.unwrap_or(f64::NAN))
+}
+
+/// A UMAT material: its library opened (the scene recorded the path absolute).
+fn umat_of(m: &crate::scene::Material) -> Result<Box<dyn Material>, String> {
+    let Some(lib) = m.library.as_deref() else {
+        return Err("is required for model \"umat\"".to_string());
+    };
+    let names = umat_state_names(m);
+    let u = Umat::new(Path::new(lib), m.props.clone(), &names, m.name.as_deref())?;
+    Ok(Box::new(u))
 }
 
 /// The named edges of a scene's zones (empty for a body of rectangles).

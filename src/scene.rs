@@ -81,6 +81,8 @@ mod validate_motion;
 pub mod validate_rigid;
 #[path = "scene/validate_supports.rs"]
 mod validate_supports;
+#[path = "scene/validate_umat.rs"]
+mod validate_umat;
 #[path = "scene/value_de.rs"]
 mod value_de;
 pub mod zones;
@@ -180,6 +182,7 @@ impl Scene {
             }
         }
         gmsh_body::import(&mut scene, source).map_err(invalid)?;
+        validate_umat::resolve_libraries(&mut scene, source);
         zones::apply_within(&mut scene).map_err(invalid)?;
         scene.steps.count =
             validate_rigid::check_stages(&scene, scene.steps.count != 0).map_err(invalid)?;

@@ -20,6 +20,7 @@ pub mod mohr_coulomb;
 pub mod placed;
 pub mod principal;
 pub mod tresca;
+pub mod umat;
 
 pub use layout::{InternalVar, Rows, StateLayout, VarKind, STRESS_LEN};
 
@@ -110,6 +111,8 @@ pub enum MaterialError {
         /// Norm of the local residual at the last iterate.
         residual: f64,
     },
+    /// A plug-in model (a UMAT) failed or asked for a smaller step; the message names it.
+    Plugin(String),
 }
 
 impl fmt::Display for MaterialError {
@@ -134,6 +137,7 @@ impl fmt::Display for MaterialError {
                 "return mapping failed to converge after {iterations} iterations \
                  (residual {residual:e})"
             ),
+            Self::Plugin(message) => f.write_str(message),
         }
     }
 }

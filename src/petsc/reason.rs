@@ -131,6 +131,8 @@ pub enum Divergence {
         linear: Option<KspDiverged>,
         iterations: usize,
         residual: f64,
+        /// Why the problem refused a trial state, for a domain error (a material's message).
+        domain: Option<String>,
     },
     /// The update fell below the step tolerance after a line search damped the step to
     /// `lambda` (< 0.5): Newton is stuck, whatever the residual.
@@ -150,10 +152,14 @@ impl fmt::Display for Divergence {
                 linear,
                 iterations,
                 residual,
+                domain,
             } => {
                 write!(f, "Newton did not converge ({reason}")?;
                 if let Some(l) = linear {
                     write!(f, ": the linear solver {l}")?;
+                }
+                if let Some(d) = domain {
+                    write!(f, ": {d}")?;
                 }
                 write!(
                     f,

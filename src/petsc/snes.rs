@@ -65,6 +65,8 @@ pub struct Snes {
 struct Ctx<'a> {
     problem: &'a mut dyn NonlinearProblem,
     error: Option<String>,
+    /// The last domain error's message: the divergence reports it (a UMAT's PNEWDT or NaN).
+    domain: Option<String>,
     reuse: Option<FactorReuse>,
     /// The residual norm at the last Jacobian of this solve.
     last_norm: Option<f64>,
@@ -189,6 +191,7 @@ impl Snes {
         let mut ctx = Ctx {
             problem,
             error: None,
+            domain: None,
             reuse: self.reuse,
             last_norm: None,
             damped_smoother: self.damped_smoother,
@@ -276,11 +279,16 @@ impl Snes {
                     )?;
                     linear = KspDiverged::from_raw(kr);
                 }
+                let domain = match reason {
+                    SnesDiverged::FunctionDomain => ctx.domain.take(),
+                    _ => None,
+                };
                 return Err(SolveFailure::Diverged(Divergence::Snes {
                     reason,
                     linear,
                     iterations,
                     residual,
+                    domain,
                 }));
             }
         }
@@ -337,6 +345,7 @@ fn report(
         Ok(Ok(())) => 0,
         Ok(Err(CallbackError::Domain(msg))) => {
             ctx_note(ctx, None, &msg);
+            ctx.domain = Some(msg);
             // SAFETY: live SNES inside its own callback.
             unsafe { ffi::SNESSetFunctionDomainError(snes) }
         }

@@ -281,6 +281,7 @@ impl Simulation {
         let _ = petsc;
         let err = |e: String| SolveError::Fatal(e);
         let step = self.header.step + 1;
+        crate::material::umat::site::set_increment(step, from, to);
         let tri_law = self.triangle_materials(mesh);
         let dofs = DofMap::build(world, mesh, self.model.pressure(&tri_law))
             .map_err(|e| err(e.to_string()))?;

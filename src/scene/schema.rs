@@ -297,6 +297,8 @@ pub enum MaterialModel {
     /// `"drucker-prager"`: the smooth cone matched to Mohr–Coulomb's `cohesion`,
     /// `friction_angle`, `dilation_angle` by `match`.
     DruckerPrager,
+    /// `"umat"`: an Abaqus UMAT in a shared library (`library`, `props`, `state_variables`).
+    Umat,
 }
 
 impl MaterialModel {
@@ -306,6 +308,7 @@ impl MaterialModel {
             MaterialModel::Tresca => "tresca",
             MaterialModel::MohrCoulomb => "mohr-coulomb",
             MaterialModel::DruckerPrager => "drucker-prager",
+            MaterialModel::Umat => "umat",
         }
     }
 
@@ -403,10 +406,12 @@ pub struct Material {
     /// The name zones give in `material = "..."`; required with several materials.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
-    /// `"linear-elastic"`, `"tresca"`, `"mohr-coulomb"` or `"drucker-prager"`.
+    /// `"linear-elastic"`, `"tresca"`, `"mohr-coulomb"`, `"drucker-prager"` or `"umat"`.
     pub model: MaterialModel,
     /// Young's modulus (Pa), > 0. Required, except for `"tresca"` with `young_over_cu`, where it
-    /// is the stiffness at the strength `cu` (young_over_cu · cu, filled in when left out).
+    /// is the stiffness at the strength `cu` (young_over_cu · cu, filled in when left out). For
+    /// `"umat"` the elastic constants the element and contact take their pressure law and
+    /// stiffness scale from (the UMAT's own, in `props`, should agree).
     #[serde(default)]
     pub young: f64,
     /// Poisson's ratio, -1 < poisson < 0.5.
@@ -450,6 +455,26 @@ pub struct Material {
     /// `"drucker-prager"` only: `"plane-strain"` (default), `"outer"` or `"inner"`.
     #[serde(default, rename = "match", skip_serializing_if = "Option::is_none")]
     pub cone_match: Option<ConeMatch>,
+    /// `"umat"` only: the shared library holding `umat_`, relative to the scene file (to the
+    /// working directory for a built-in scene); the resolved scene records it absolute.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub library: Option<String>,
+    /// `"umat"` only: PROPS, in the order the UMAT reads them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub props: Vec<f64>,
+    /// `"umat"` only: the number of PROPS the UMAT expects, checked against `props` when given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nprops: Option<usize>,
+    /// `"umat"` only: NSTATV, state variables per Gauss point, `statev_1 ...` unless named.
+    #[serde(default, skip_serializing_if = "is_zero_usize")]
+    pub state_variables: usize,
+    /// `"umat"` only: names of the state variables in outputs and checkpoints.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub state_names: Vec<String>,
+}
+
+fn is_zero_usize(n: &usize) -> bool {
+    *n == 0
 }
 
 fn is_zero(x: &f64) -> bool {

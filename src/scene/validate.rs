@@ -666,7 +666,9 @@ fn check_material(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invali
     }
     non_negative(mat.join("density"), m.density)?;
     foreign_keys(m, mat)?;
+    super::validate_umat::check(m, mat)?;
     match m.model {
+        MaterialModel::Umat => non_negative(mat.join("cu"), m.cu),
         MaterialModel::Tresca => {
             if !(m.cu > 0.0 && m.cu.is_finite()) {
                 return fail(

@@ -431,6 +431,7 @@ impl<'a> StepProblem<'a> {
         let at = |k: usize| local[self.local_dof(t, k)];
         let du: [[f64; 2]; 6] = std::array::from_fn(|k| [at(2 * k), at(2 * k + 1)]);
         let geometry = self.geometry(t);
+        crate::material::umat::site::set_element(t, &geometry);
         let flat = |k: &[f64]| if tangent { k.to_vec() } else { Vec::new() };
         let result = match s.kernel {
             Kernel::P2 => p2_element_with(
