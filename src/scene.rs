@@ -177,7 +177,7 @@ impl Scene {
         };
         // `young` left out beside `young_over_cu` is the stiffness at the strength `cu`.
         for m in scene.material.0.iter_mut() {
-            if let (Some(ratio), 0.0) = (m.young_over_cu, m.young) {
+            if let (Some(ratio), true) = (m.young_over_cu, m.young.is_nan()) {
                 m.young = ratio * m.cu;
             }
         }

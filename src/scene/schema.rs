@@ -412,7 +412,7 @@ pub struct Material {
     /// is the stiffness at the strength `cu` (young_over_cu · cu, filled in when left out). For
     /// `"umat"` the elastic constants the element and contact take their pressure law and
     /// stiffness scale from (the UMAT's own, in `props`, should agree).
-    #[serde(default)]
+    #[serde(default = "not_given")]
     pub young: f64,
     /// Poisson's ratio, -1 < poisson < 0.5.
     pub poisson: f64,
@@ -471,6 +471,11 @@ pub struct Material {
     /// `"umat"` only: names of the state variables in outputs and checkpoints.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub state_names: Vec<String>,
+}
+
+/// A required number left out (NaN: no TOML scene writes it by accident).
+fn not_given() -> f64 {
+    f64::NAN
 }
 
 fn is_zero_usize(n: &usize) -> bool {

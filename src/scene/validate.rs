@@ -642,6 +642,9 @@ fn check_materials(s: &Scene) -> Result<(), Invalid> {
 
 /// The parameters of one material, at `mat`.
 fn check_material(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
+    if m.young.is_nan() {
+        return fail(mat.join("young"), "required key is missing".to_string());
+    }
     if let Some(ratio) = m.young_over_cu {
         positive(mat.join("young_over_cu"), ratio)?;
         let derived = ratio * m.cu;
