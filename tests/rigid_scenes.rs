@@ -151,11 +151,13 @@ fn pipeline_coarse_vertical_then_lateral() {
     assert!(v[15] < v[9]);
     // Smooth pipe in the vertical stage: no horizontal force to speak of.
     assert!(h[9].abs() < 0.1 * v[9]);
-    // The vertical stage agrees across rank counts to 1e-5 (measured); sideways, plastic flow
-    // round the pipe with cut steps amplifies the ranks' round-off (parallel MUMPS) to 1.2 % by
-    // step 16 (measured), inside the stage's own step-to-step scatter of 15 %.
+    // With contact inside Newton the vertical stage parts between 1 and 2 ranks from step 7 by
+    // 1.3e-3 (measured; 1e-5 with the old augmentation loop): which nodes touch is decided
+    // in the same Newton loop as the plastic flow, so the ranks' round-off (parallel MUMPS) can
+    // take another path there (issue 30, open). Sideways, plastic flow round the pipe with cut
+    // steps amplifies it to 1.2 % by step 16, inside the stage's own scatter of 15 %.
     let v2 = column(&dir, &r2, "V_over_Dcu");
-    close(&v[..10], &v2[..10], 1e-4);
+    close(&v[..10], &v2[..10], 2e-3);
     close(&v[10..], &v2[10..], 3e-2);
 }
 
@@ -177,8 +179,9 @@ fn staged_run_restarts_in_its_second_stage_on_another_rank_count() {
         let whole = column(&dir, "whole", name);
         let split = column(&dir, "split", name);
         println!("{name}: whole {:?} split {:?}", &whole[12..], &split[12..]);
-        // Measured: 1.2e-5 at the checkpoint (the ranks' round-off in the first 12 steps), at
-        // most 1.0e-4 after it.
-        close(&split, &whole, 1e-3);
+        // Measured with contact inside Newton: 1.3e-3 from step 7 (the two rank counts' own
+        // parting in the vertical stage, `pipeline_coarse_...`), carried through the
+        // checkpoint; the old augmentation loop gave 1.2e-5 at the checkpoint.
+        close(&split, &whole, 3e-3);
     }
 }

@@ -177,7 +177,11 @@ fn tresca_umat_holds_two_cu_and_checkpoints_its_state_by_name() {
         // Plane-strain compression between smooth platens: σyy − σxx = 2cu exactly once
         // yielded (from step 2).
         assert!(worst < 1e-6, "stress/cu off 2 by {worst:e}");
-        assert!(diff < 1e-8, "differs from the built-in tresca by {diff:e}");
+        // A UMAT is not declared isochoric, so the mixed element takes its full stress (the P1
+        // pressure the projection of the UMAT's own, as for the frictional models) where the
+        // built-in Tresca closes the pressure with its elastic volume law: the two
+        // formulations agree to 1.2e-6 here (measured), both at 2 cu.
+        assert!(diff < 1e-5, "differs from the built-in tresca by {diff:e}");
         assert!(!log.contains("(cut"), "no cut without PNEWDT:\n{log}");
     }
     // The state variables come back from a checkpoint: a restart at step 5 ends where the

@@ -732,7 +732,7 @@ fn check_material(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invali
 fn foreign_keys(m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
     use MaterialModel::*;
     let given: [(&str, bool, &[MaterialModel]); 9] = [
-        ("cu", m.cu != 0.0, &[Tresca, LinearElastic]),
+        ("cu", m.cu != 0.0, &[Tresca, LinearElastic, Umat]),
         ("cu_gradient", m.cu_gradient != 0.0, &[Tresca]),
         ("reference_level", m.reference_level.is_some(), &[Tresca]),
         ("young_over_cu", m.young_over_cu.is_some(), &[Tresca]),
