@@ -55,6 +55,6 @@ pub use gmsh::{
 pub use locate::Location;
 pub use overlap::{overlap, validate_zones};
 pub use polygon::{Polygon, Segment};
-pub use segment::Point;
+pub use segment::{distance as distance_to_segment, Point};
 pub use select::{gmsh_segments, zone_segments, NamedBoundaries, UnknownBoundary};
 pub use shape::{Circle, Rectangle, Shape};

@@ -26,7 +26,7 @@
 //! apex σ = (ξ c / η) I with a zero tangent. The consistent tangent is symmetric when η̄ = η.
 
 use super::elastic::LinearElastic;
-use super::layout::internal_len;
+use super::layout::{equivalent_plastic_strain, grew, internal_len};
 use super::mohr_coulomb::{check_strength, EPS_Q, PLASTIC_STRAIN, VARIABLES};
 use super::principal::product;
 use super::{GaussState, InternalVar, Material, MaterialError, MaterialResponse};
@@ -212,8 +212,7 @@ impl Material for DruckerPrager {
         {
             *p += d;
         }
-        let sq = dep[0] * dep[0] + dep[1] * dep[1] + dep[2] * dep[2] + 0.5 * dep[3] * dep[3];
-        state.internal[EPS_Q] += (2.0 / 3.0 * sq).sqrt();
+        state.internal[EPS_Q] += equivalent_plastic_strain(&dep);
         Ok(MaterialResponse {
             s,
             d: product(&m, &trial.d),
@@ -234,8 +233,7 @@ impl Material for DruckerPrager {
     }
 
     fn yielded(&self, before: &GaussState, after: &GaussState) -> bool {
-        let q = |s: &GaussState| s.internal.get(EPS_Q).copied().unwrap_or(0.0);
-        q(after) > q(before)
+        grew(before, after, EPS_Q)
     }
 
     fn symmetric_tangent(&self) -> bool {

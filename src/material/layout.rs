@@ -276,6 +276,20 @@ impl Rows {
     }
 }
 
+/// The von Mises equivalent of a plastic strain increment (engineering shear in slot 3),
+/// √(2/3 Δεp:Δεp): what the `eps_q` variable of the plastic models accumulates.
+pub fn equivalent_plastic_strain(dep: &[f64]) -> f64 {
+    let sq = dep[0] * dep[0] + dep[1] * dep[1] + dep[2] * dep[2] + 0.5 * dep[3] * dep[3];
+    (2.0 / 3.0 * sq).sqrt()
+}
+
+/// Whether the variable at `at` (a plastic model's `eps_q`) grew from `before` to `after`:
+/// how those models tell that a point yielded.
+pub fn grew(before: &super::GaussState, after: &super::GaussState, at: usize) -> bool {
+    let q = |s: &super::GaussState| s.internal.get(at).copied().unwrap_or(0.0);
+    q(after) > q(before)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -31,7 +31,7 @@
 //! it) and `eps_q` = Σ √(2/3 Δε^p:Δε^p).
 
 use super::elastic::LinearElastic;
-use super::layout::internal_len;
+use super::layout::{equivalent_plastic_strain, grew, internal_len};
 use super::principal::{product, solve_small, Spectral};
 use super::{GaussState, InternalVar, Material, MaterialError, MaterialResponse};
 
@@ -346,8 +346,7 @@ impl Material for MohrCoulomb {
         {
             *p += d;
         }
-        let sq = dep[0] * dep[0] + dep[1] * dep[1] + dep[2] * dep[2] + 0.5 * dep[3] * dep[3];
-        state.internal[EPS_Q] += (2.0 / 3.0 * sq).sqrt();
+        state.internal[EPS_Q] += equivalent_plastic_strain(&dep);
         Ok(MaterialResponse {
             s: frame.compose(&values),
             d: product(&frame.isotropic_tangent(&values, &dv), &trial.d),
@@ -368,8 +367,7 @@ impl Material for MohrCoulomb {
     }
 
     fn yielded(&self, before: &GaussState, after: &GaussState) -> bool {
-        let q = |s: &GaussState| s.internal.get(EPS_Q).copied().unwrap_or(0.0);
-        q(after) > q(before)
+        grew(before, after, EPS_Q)
     }
 
     fn symmetric_tangent(&self) -> bool {

@@ -44,7 +44,7 @@
 //! Cauchy stress), and the end-of-step Cauchy stress is on the yield surface to round-off.
 
 use super::elastic::LinearElastic;
-use super::layout::internal_len;
+use super::layout::{grew, internal_len};
 use super::{GaussState, InternalVar, Material, MaterialError, MaterialResponse};
 
 /// The internal variables: the accumulated plastic strain (engineering shear) and its
@@ -265,8 +265,7 @@ impl Material for Tresca {
     }
 
     fn yielded(&self, before: &GaussState, after: &GaussState) -> bool {
-        let q = |s: &GaussState| s.internal.get(EPS_Q).copied().unwrap_or(0.0);
-        q(after) > q(before)
+        grew(before, after, EPS_Q)
     }
 }
 

@@ -232,19 +232,11 @@ fn in_ring(v: &[[f64; 2]], p: [f64; 2], tol: f64) -> bool {
     let mut inside = false;
     for k in 0..n {
         let (a, b) = (v[k], v[(k + 1) % n]);
-        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-        let len2 = dx * dx + dy * dy;
-        let t = if len2 > 0.0 {
-            (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let (qx, qy) = (a[0] + t * dx - p[0], a[1] + t * dy - p[1]);
-        if qx * qx + qy * qy <= tol * tol {
+        if crate::geometry::distance_to_segment(a, b, p) <= tol {
             return true;
         }
         if (a[1] > p[1]) != (b[1] > p[1]) {
-            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * dx;
+            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
             if p[0] < x {
                 inside = !inside;
             }
