@@ -1,5 +1,6 @@
 //! What a scene means for the solver: material, element, supports, prescribed motion, loads.
 
+use crate::fem::analysis::Analysis;
 use crate::geometry::NamedBoundaries;
 use crate::material::drucker_prager::{DruckerPrager, Match};
 use crate::material::elastic::LinearElastic;
@@ -62,7 +63,7 @@ pub fn materials_of(scene: &Scene) -> Result<Vec<Box<dyn Material>>, String> {
         };
         let model = match m.model {
             MaterialModel::Umat => umat_of(m).map_err(|e| format!("{at}.library: {e}"))?,
-            _ => material_of(m).map_err(|e| format!("{at}: {e}"))?,
+            _ => material_of(m, scene.analysis).map_err(|e| format!("{at}: {e}"))?,
         };
         out.push(match all.len() {
             1 => model,
@@ -73,7 +74,11 @@ pub fn materials_of(scene: &Scene) -> Result<Vec<Box<dyn Material>>, String> {
 }
 
 /// The constitutive model of one scene material, its parameters checked.
-fn material_of(m: &crate::scene::Material) -> Result<Box<dyn Material>, MaterialError> {
+/// In axisymmetry a model judges the hoop stress among the principal ones.
+fn material_of(
+    m: &crate::scene::Material,
+    analysis: Analysis,
+) -> Result<Box<dyn Material>, MaterialError> {
     let named = |e: MaterialError| e;
     Ok(match m.model {
         MaterialModel::LinearElastic => {
@@ -83,6 +88,9 @@ fn material_of(m: &crate::scene::Material) -> Result<Box<dyn Material>, Material
             let mut t = Tresca::new(m.young, m.poisson, m.cu).map_err(named)?;
             if let Some(ratio) = m.young_over_cu {
                 t = t.with_young_over_cu(ratio);
+            }
+            if analysis.has_hoop() {
+                t = t.in_principal_stresses();
             }
             match (m.cu_gradient, m.reference_level) {
                 (k, Some(level)) if k != 0.0 => {
@@ -305,6 +313,11 @@ impl Model {
                     Selection::Current => face(p, c) + p.total[c] * to - x[c],
                 });
             }
+        }
+        // On the axis of an axisymmetric body a radial displacement would open a hole (or
+        // pass through the axis): symmetry holds it, whatever the scene says.
+        if self.scene.analysis.has_hoop() && x[0].abs() <= self.tol {
+            bc[0] = Some(0.0);
         }
         bc
     }

@@ -71,6 +71,8 @@ pub mod schema;
 pub mod selector;
 #[path = "scene/validate.rs"]
 mod validate;
+#[path = "scene/validate_axisymmetry.rs"]
+mod validate_axisymmetry;
 #[path = "scene/validate_fine.rs"]
 mod validate_fine;
 #[path = "scene/validate_loads.rs"]

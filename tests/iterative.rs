@@ -7,6 +7,7 @@
 mod common;
 
 use common::{history, ok, workdir};
+use pfem_mpi::fem::analysis::Analysis;
 use pfem_mpi::fem::element::p2_element;
 use pfem_mpi::fem::mixed::p2p1_element;
 use pfem_mpi::fem::p2::straight_sided;
@@ -505,9 +506,18 @@ fn rigid_body_modes_are_in_the_kernel_of_the_stress_free_tangents() {
     let mixed = kernel_residuals(
         1,
         |x| {
-            let e = p2p1_element(x, &[[0.0; 2]; 6], &[0.0; 3], &states, &soft, bulk, [0.0; 2])
-                .expect("element")
-                .with_pressure_scale(4.0e6);
+            let e = p2p1_element(
+                x,
+                &[[0.0; 2]; 6],
+                &[0.0; 3],
+                &states,
+                &soft,
+                bulk,
+                [0.0; 2],
+                Analysis::PlaneStrain,
+            )
+            .expect("element")
+            .with_pressure_scale(4.0e6);
             e.tangent.as_flattened().to_vec()
         },
         rigid,

@@ -11,11 +11,16 @@
 //! - residual = f_int − ∫_{Ω_n} N_a b dV, with b the body force per unit volume at x_n;
 //! - σ_{n+1} = F S Fᵀ / J in-plane, σzz_{n+1} = S_zz / J.
 //!
-//! Plane strain, unit thickness. Dof order: node0 ux, node0 uy, node1 ux, …, node5 uy, with the
+//! In axisymmetry ([`Analysis::Axisymmetric`], x the radius) F also has the hoop stretch
+//! F_θθ = 1 + h_θ, h_θ = Δu_r/r, so E_zz = h_θ + ½h_θ² (δE_zz = F_θθ N_a δu_{a,r}/r), the
+//! geometric stiffness gains S_zz N_a N_b/r² on the radial components, σzz_{n+1} = F_θθ² S_zz/J
+//! with J = J_2D F_θθ, and every Gauss weight carries 2π r. In plane strain h_θ = 0 and the
+//! measure is unit thickness. Dof order: node0 ux, node0 uy, node1 ux, …, node5 uy, with the
 //! node order of [`crate::fem::p2`].
 
 use std::fmt;
 
+use crate::fem::analysis::{hoop_gradient, Analysis};
 use crate::fem::p2::{self, N_NODES};
 use crate::fem::quadrature::{area_to_reference, TRI3_POINTS, TRI3_WEIGHTS};
 use crate::material::{GaussState, Material, MaterialError};
@@ -153,18 +158,28 @@ pub fn p2_element(
     mat: &dyn Material,
     body_force: [f64; 2],
 ) -> Result<ElementOutput, ElementError> {
-    p2_element_with(x, du, states_n, mat, body_force, true)
+    p2_element_with(
+        x,
+        du,
+        states_n,
+        mat,
+        body_force,
+        Analysis::PlaneStrain,
+        true,
+    )
 }
 
 /// [`p2_element`], with the tangent formed only if `with_tangent` (else left zero), for
 /// evaluations where no tangent is read or cached (`StepProblem::evaluate`: the line search's and
-/// the converged state's residuals on the iterative path): forming it was most of their cost.
+/// the converged state's residuals on the iterative path): forming it was most of their cost;
+/// and in the `analysis` given ([`p2_element`] is plane strain).
 pub fn p2_element_with(
     x: &[[f64; 2]; N_NODES],
     du: &[[f64; 2]; N_NODES],
     states_n: &[GaussState; N_GAUSS],
     mat: &dyn Material,
     body_force: [f64; 2],
+    analysis: Analysis,
     with_tangent: bool,
 ) -> Result<ElementOutput, ElementError> {
     let mut residual = [0.0; N_DOFS];
@@ -179,23 +194,29 @@ pub fn p2_element_with(
             gauss: q,
             det_j: e.det_j,
         })?;
-        let w = TRI3_WEIGHTS[q] * pg.det_j;
+        let n = p2::shape(xi);
+        let r = p2::map_to_physical(x, xi)[0];
+        let w = TRI3_WEIGHTS[q] * pg.det_j * analysis.measure(r);
         let g = &pg.grad;
 
         let h = displacement_gradient(g, du);
-        let j = jacobian_of(&h);
+        let ur: f64 = n.iter().zip(du).map(|(na, ua)| na * ua[0]).sum();
+        let h_hoop = hoop_gradient(analysis, r, ur);
+        let f_hoop = 1.0 + h_hoop;
+        let j = jacobian_of(&h) * f_hoop;
         if !j.is_finite() || j <= 0.0 {
             return Err(ElementError::Inverted { gauss: q, j });
         }
         let f = [[1.0 + h[0][0], h[0][1]], [h[1][0], 1.0 + h[1][1]]];
-        let e = green_lagrange(&h);
+        let mut e = green_lagrange(&h);
+        e[2] = h_hoop + 0.5 * h_hoop * h_hoop;
         let resp = mat
             .update(&states_n[q], &e)
             .map_err(|source| ElementError::Material { gauss: q, source })?;
         let s = resp.s;
         let d = resp.d;
 
-        // B_NL (4 x 12): δE = B_NL δu. The zz row is identically zero in plane strain.
+        // B_NL (4 x 12): δE = B_NL δu. The zz row is the hoop's, zero in plane strain.
         let mut b = [[0.0; N_DOFS]; 4];
         for (a, ga) in g.iter().enumerate() {
             for (i, fi) in f.iter().enumerate() {
@@ -204,9 +225,11 @@ pub fn p2_element_with(
                 b[1][col] = fi[1] * ga[1];
                 b[3][col] = fi[0] * ga[1] + fi[1] * ga[0];
             }
+            if analysis.has_hoop() {
+                b[2][2 * a] = f_hoop * n[a] / r;
+            }
         }
 
-        let n = p2::shape(xi);
         for k in 0..N_DOFS {
             let mut fk = 0.0;
             for (bi, si) in b.iter().zip(s.iter()) {
@@ -216,24 +239,32 @@ pub fn p2_element_with(
         }
         let mut st = resp.state;
         st.stress = push_forward(&f, &s, j);
+        st.stress[2] *= f_hoop * f_hoop;
         states[q] = st;
         if !with_tangent {
             continue;
         }
 
-        // Weighted D·B on the in-plane rows (B's zz row is zero), so the material stiffness
+        // Weighted D·B on the in-plane rows and, with a hoop, the zz row (db's rows in the order
+        // xx, yy, xy, zz; B's zz row is zero in plane strain), so the material stiffness
         // below is a plain Bᵀ·(wDB) product. Where the material says its tangent is symmetric
         // the element's is too (the geometric part always is): its upper triangle is formed,
         // and mirrored once after the last Gauss point, which halves the work.
         const IN_PLANE: [usize; 3] = [0, 1, 3];
+        const WITH_HOOP: [usize; 4] = [0, 1, 3, 2];
+        let rows: &[usize] = if analysis.has_hoop() {
+            &WITH_HOOP
+        } else {
+            &IN_PLANE
+        };
         debug_assert!(
             full || (0..4).all(|i| (0..i).all(|j| (d[i][j] - d[j][i]).abs()
                 <= 1e-9 * d.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs())))),
             "the material tangent is not symmetric: {d:?}"
         );
-        let mut db = [[0.0; N_DOFS]; 3];
-        for (dbi, &i) in db.iter_mut().zip(IN_PLANE.iter()) {
-            for &jj in IN_PLANE.iter() {
+        let mut db = [[0.0; N_DOFS]; 4];
+        for (dbi, &i) in db.iter_mut().zip(rows.iter()) {
+            for &jj in rows.iter() {
                 let c = w * d[i][jj];
                 if c != 0.0 {
                     for (x_, bjk) in dbi.iter_mut().zip(b[jj].iter()) {
@@ -243,9 +274,9 @@ pub fn p2_element_with(
             }
         }
         for (k, row) in tangent.iter_mut().enumerate() {
-            let bk = [b[0][k], b[1][k], b[3][k]];
+            let bk = [b[0][k], b[1][k], b[3][k], b[2][k]];
             for (l, r) in row.iter_mut().enumerate().skip(if full { 0 } else { k }) {
-                *r += bk[0] * db[0][l] + bk[1] * db[1][l] + bk[2] * db[2][l];
+                *r += bk[0] * db[0][l] + bk[1] * db[1][l] + bk[2] * db[2][l] + bk[3] * db[3][l];
             }
         }
 
@@ -256,6 +287,15 @@ pub fn p2_element_with(
                 let kg = w * (sa[0] * gb[0] + sa[1] * gb[1]);
                 tangent[2 * a][2 * bn] += kg;
                 tangent[2 * a + 1][2 * bn + 1] += kg;
+            }
+        }
+        if analysis.has_hoop() {
+            // ∂²E_zz/∂u_{a,r}∂u_{b,r} = N_a N_b / r².
+            let c = w * s[2] / (r * r);
+            for a in 0..N_NODES {
+                for bn in (if full { 0 } else { a })..N_NODES {
+                    tangent[2 * a][2 * bn] += c * n[a] * n[bn];
+                }
             }
         }
     }
@@ -356,8 +396,16 @@ mod tests {
         let du = homogeneous_du(&x, &f, [0.5, 0.2]);
         let body = [0.5e3, -2.0e4];
         let full = p2_element(&x, &du, &prestress(), &elastic(), body).expect("valid element");
-        let lean =
-            p2_element_with(&x, &du, &prestress(), &elastic(), body, false).expect("valid element");
+        let lean = p2_element_with(
+            &x,
+            &du,
+            &prestress(),
+            &elastic(),
+            body,
+            Analysis::PlaneStrain,
+            false,
+        )
+        .expect("valid element");
         assert_eq!(
             full.residual.map(f64::to_bits),
             lean.residual.map(f64::to_bits)
@@ -365,6 +413,91 @@ mod tests {
         assert_eq!(format!("{:?}", full.states), format!("{:?}", lean.states));
         assert!(lean.tangent.iter().flatten().all(|&k| k == 0.0));
         assert!(full.tangent.iter().flatten().any(|&k| k != 0.0));
+    }
+
+    /// Relative Frobenius error of the tangent against central differences of the residual.
+    fn fd_error(
+        x: &[[f64; 2]; 6],
+        du: &[[f64; 2]; 6],
+        states: &[GaussState; 3],
+        mat: &dyn Material,
+        analysis: Analysis,
+    ) -> f64 {
+        let body = [0.5e3, -2.0e4];
+        let eval = |u: &[[f64; 2]; 6]| {
+            p2_element_with(x, u, states, mat, body, analysis, true).expect("valid element")
+        };
+        let out = eval(du);
+        let h = 1e-7;
+        let (mut num, mut den) = (0.0, 0.0);
+        for l in 0..N_DOFS {
+            let (mut p, mut m) = (*du, *du);
+            p[l / 2][l % 2] += h;
+            m[l / 2][l % 2] -= h;
+            let (rp, rm) = (eval(&p), eval(&m));
+            for k in 0..N_DOFS {
+                let fd = (rp.residual[k] - rm.residual[k]) / (2.0 * h);
+                num += (fd - out.tangent[k][l]).powi(2);
+                den += out.tangent[k][l].powi(2);
+            }
+        }
+        (num / den).sqrt()
+    }
+
+    #[test]
+    fn axisymmetric_tangent_matches_central_differences() {
+        use crate::material::mohr_coulomb::MohrCoulomb;
+        let x = curved_element();
+        let f = mul(&rot(0.3), &[[1.05, 0.02], [0.02, 0.97]]);
+        let mut du = homogeneous_du(&x, &f, [0.5, 0.2]);
+        for (d, xa) in du.iter_mut().zip(x.iter()) {
+            d[0] += 0.03 * xa[0] * xa[1];
+            d[1] -= 0.02 * xa[0] * xa[0];
+        }
+        let err = fd_error(&x, &du, &prestress(), &elastic(), Analysis::Axisymmetric);
+        assert!(err < 1e-6, "elastic: {err:e}");
+        // A non-symmetric plastic tangent (ψ < φ) with the hoop among the principal stresses.
+        let mc = MohrCoulomb::new(6.0e6, 0.3, 5.0e3, 30.0, 5.0, None).expect("valid");
+        let small = du.map(|d| [0.1 * d[0], 0.1 * d[1]]);
+        let zero: [GaussState; 3] = std::array::from_fn(|_| GaussState::default());
+        let out = p2_element_with(
+            &x,
+            &small,
+            &zero,
+            &mc,
+            [0.0; 2],
+            Analysis::Axisymmetric,
+            true,
+        )
+        .expect("valid element");
+        assert!(out.states.iter().any(|s| s.internal[4] > 0.0), "must yield");
+        let err = fd_error(&x, &small, &zero, &mc, Analysis::Axisymmetric);
+        assert!(err < 1e-6, "Mohr–Coulomb: {err:e}");
+    }
+
+    #[test]
+    fn axisymmetric_uniform_radial_stretch_gives_the_hoop_stress() {
+        // Δu = ε (x, 0): F = diag(1 + ε, 1, 1 + ε); with zero prestress S = D E and the hoop
+        // stress is the in-plane xx one.
+        let x = curved_element();
+        let eps = 1e-3;
+        let du = x.map(|p| [eps * p[0], 0.0]);
+        let zero = std::array::from_fn(|_| GaussState::default());
+        let out = p2_element_with(
+            &x,
+            &du,
+            &zero,
+            &elastic(),
+            [0.0; 2],
+            Analysis::Axisymmetric,
+            true,
+        )
+        .expect("valid element");
+        for st in &out.states {
+            let s = st.stress;
+            assert!((s[2] - s[0]).abs() <= 1e-12 * s[0].abs(), "{s:?}");
+            assert!(s[3].abs() <= 1e-9 * s[0].abs(), "{s:?}");
+        }
     }
 
     #[test]

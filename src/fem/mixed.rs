@@ -77,6 +77,7 @@
 //! of the mesh) rescales the pressure unknown to π = p/α, which has the units and the magnitude
 //! of a displacement, and the pressure rows to force units, keeping the saddle point symmetric.
 
+use crate::fem::analysis::{hoop_gradient, Analysis};
 use crate::fem::element::{displacement_gradient, green_lagrange, ElementError, N_GAUSS};
 use crate::fem::p2::{self, N_NODES};
 use crate::fem::quadrature::{area_to_reference, TRI3_POINTS, TRI3_WEIGHTS};
@@ -149,28 +150,41 @@ fn atanh_ratio(x: f64) -> (f64, f64) {
 
 /// Kinematic quantities of one Gauss point and their derivatives with respect to H.
 /// Derivative arrays are indexed by 2j + l for H_jl = ∂Δu_j/∂x_l.
+/// Index 4 of the derivative arrays is the hoop gradient h_θ = Δu_r/r (axisymmetry).
 struct StepKinematics {
+    /// J = det F, the hoop stretch included, and J − 1.
     j: f64,
     jm1: f64,
+    /// The in-plane F⁻¹.
     finv: Mat2,
     rot: Mat2,
-    dtheta: [f64; 4],
-    /// ε = ln U, Voigt `[xx, yy, zz, xy]`, engineering shear.
+    dtheta: [f64; 5],
+    /// F_θθ = 1 + h_θ (1 in plane strain).
+    f_hoop: f64,
+    /// ε = ln U, Voigt `[xx, yy, zz, xy]`, engineering shear; ε_zz = ln F_θθ.
     eps: [f64; 4],
-    deps: [[f64; 4]; 4],
+    deps: [[f64; 4]; 5],
 }
 
-/// Everything derived from H; `Err(J)` if the step inverts the material (J ≤ 0 or not finite)
-/// or is so close to it that C = FᵀF is numerically singular (x rounds to 1, J ≈ 0).
-fn step_kinematics(h: &Mat2) -> Result<StepKinematics, f64> {
+/// Everything derived from H and the hoop gradient `h_hoop` (0 in plane strain); `Err(J)` if
+/// the step inverts the material (J ≤ 0 or not finite) or is so close to it that C = FᵀF is
+/// numerically singular (x rounds to 1, J ≈ 0).
+fn step_kinematics(h: &Mat2, h_hoop: f64) -> Result<StepKinematics, f64> {
     // J − 1 kept separate so that tiny steps keep full relative precision in ln J and J − 1.
-    let jm1 = h[0][0] + h[1][1] + (h[0][0] * h[1][1] - h[0][1] * h[1][0]);
+    let jm1_plane = h[0][0] + h[1][1] + (h[0][0] * h[1][1] - h[0][1] * h[1][0]);
+    let j_plane = 1.0 + jm1_plane;
+    let f_hoop = 1.0 + h_hoop;
+    let jm1 = jm1_plane + h_hoop + jm1_plane * h_hoop;
     let j = 1.0 + jm1;
-    if !(j.is_finite() && j > 0.0) {
+    if !(j.is_finite() && j > 0.0 && j_plane > 0.0 && f_hoop > 0.0) {
         return Err(j);
     }
+    let j = j_plane * f_hoop;
     let f = [[1.0 + h[0][0], h[0][1]], [h[1][0], 1.0 + h[1][1]]];
-    let finv = [[f[1][1] / j, -f[0][1] / j], [-f[1][0] / j, f[0][0] / j]];
+    let finv = [
+        [f[1][1] / j_plane, -f[0][1] / j_plane],
+        [-f[1][0] / j_plane, f[0][0] / j_plane],
+    ];
 
     // 2-D polar rotation: R = rot(θ), tan θ = (F10 − F01)/(F00 + F11); the pair cannot vanish
     // when det F > 0.
@@ -179,7 +193,7 @@ fn step_kinematics(h: &Mat2) -> Result<StepKinematics, f64> {
     let (sn, cs) = b.atan2(a).sin_cos();
     let rot = [[cs, -sn], [sn, cs]];
     let ab2 = a * a + b * b;
-    let dtheta = [-b / ab2, -a / ab2, a / ab2, -b / ab2];
+    let dtheta = [-b / ab2, -a / ab2, a / ab2, -b / ab2, 0.0];
 
     // ε = ½ ln C, C = I + 2E: eigenvalues of C are m_C ± 2ρ with m_C = 1 + tr E and ρ the
     // eigenvalue of dev E, so ε = ½ ln J I + (g(x)/m) dev E with x = 2ρ/m (< 1 as C is SPD).
@@ -193,18 +207,19 @@ fn step_kinematics(h: &Mat2) -> Result<StepKinematics, f64> {
     }
     let (g, hh) = atanh_ratio(x);
     let phi = g / m;
-    let half_ln_j = 0.5 * jm1.ln_1p();
+    let half_ln_j = 0.5 * jm1_plane.ln_1p();
     let eps = [
         half_ln_j + phi * dd,
         half_ln_j - phi * dd,
-        0.0,
+        h_hoop.ln_1p(),
         2.0 * phi * de,
     ];
 
-    let mut deps = [[0.0; 4]; 4];
-    for (jl, dep) in deps.iter_mut().enumerate() {
+    let mut deps = [[0.0; 4]; 5];
+    deps[4][2] = 1.0 / f_hoop;
+    for (jl, dep) in deps.iter_mut().take(4).enumerate() {
         let (jj, l) = (jl / 2, jl % 2);
-        // ∂E_ik/∂H_jl = ½ (δ_il F_jk + δ_kl F_ji), and ∂ln J/∂H_jl = (F⁻¹)_lj.
+        // ∂E_ik/∂H_jl = ½ (δ_il F_jk + δ_kl F_ji), and ∂ln J/∂H_jl = (F⁻¹)_lj (in-plane J).
         let d_e00 = if l == 0 { f[jj][0] } else { 0.0 };
         let d_e11 = if l == 1 { f[jj][1] } else { 0.0 };
         let d_e01 = 0.5 * if l == 0 { f[jj][1] } else { f[jj][0] };
@@ -228,6 +243,7 @@ fn step_kinematics(h: &Mat2) -> Result<StepKinematics, f64> {
         finv,
         rot,
         dtheta,
+        f_hoop,
         eps,
         deps,
     })
@@ -236,12 +252,12 @@ fn step_kinematics(h: &Mat2) -> Result<StepKinematics, f64> {
 /// Logarithmic step strain ε = ln U = ½ ln(FᵀF) of F = I + H, Voigt `[xx, yy, zz, xy]` with
 /// engineering shear, in the start-of-step frame; `None` if det F ≤ 0.
 pub fn log_strain(h: &Mat2) -> Option<[f64; 4]> {
-    step_kinematics(h).ok().map(|k| k.eps)
+    step_kinematics(h, 0.0).ok().map(|k| k.eps)
 }
 
 /// Rotation R of the polar decomposition F = R U of F = I + H; `None` if det F ≤ 0.
 pub fn step_rotation(h: &Mat2) -> Option<Mat2> {
-    step_kinematics(h).ok().map(|k| k.rot)
+    step_kinematics(h, 0.0).ok().map(|k| k.rot)
 }
 
 fn mul(a: &Mat2, b: &Mat2) -> Mat2 {
@@ -289,7 +305,9 @@ fn invalid_bulk(bulk: f64) -> ElementError {
 ///   its compressible response (e.g. [`crate::material::tresca::Tresca::bulk_modulus`]) or
 ///   `f64::INFINITY` for exact incompressibility. An invalid value is reported as
 ///   [`ElementError::Material`] (Gauss point 0) wrapping an `InvalidParameter` named `bulk`;
-/// - `body_force`: force per unit volume of Ω_n.
+/// - `body_force`: force per unit volume of Ω_n;
+/// - `analysis`: plane strain, or axisymmetry with the hoop terms of the module docs.
+#[allow(clippy::too_many_arguments)]
 pub fn p2p1_element(
     x: &[[f64; 2]; N_NODES],
     du: &[[f64; 2]; N_NODES],
@@ -298,6 +316,7 @@ pub fn p2p1_element(
     mat: &dyn Material,
     bulk: f64,
     body_force: [f64; 2],
+    analysis: Analysis,
 ) -> Result<MixedOutput, ElementError> {
     // A model that is not isochoric takes K as the scale of its projected pressure, which
     // must then be finite.
@@ -317,13 +336,22 @@ pub fn p2p1_element(
             gauss: q,
             det_j: e.det_j,
         })?;
-        let w = TRI3_WEIGHTS[q] * pg.det_j;
+        let n = p2::shape(xi);
+        let radius = p2::map_to_physical(x, xi)[0];
+        let w = TRI3_WEIGHTS[q] * pg.det_j * analysis.measure(radius);
         let gx = &pg.grad;
 
         let h = displacement_gradient(gx, du);
-        let kin = step_kinematics(&h).map_err(|j| ElementError::Inverted { gauss: q, j })?;
+        let ur: f64 = n.iter().zip(du).map(|(na, ua)| na * ua[0]).sum();
+        let h_hoop = hoop_gradient(analysis, radius, ur);
+        let kin =
+            step_kinematics(&h, h_hoop).map_err(|j| ElementError::Inverted { gauss: q, j })?;
         let j = kin.j;
         let r = &kin.rot;
+        let hoop = analysis.has_hoop();
+        // ∂h_θ/∂u_{b,r} = N_b / r: the hoop's share of the radial columns (0 in plane strain).
+        let hoop_shape: [f64; N_NODES] =
+            std::array::from_fn(|a| if hoop { n[a] / radius } else { 0.0 });
 
         // A stiffness that varies from point to point (`young_over_cu`) varies K too.
         let inv_k = mat.bulk_at(&states_n[q]).map_or(inv_k, |k| 1.0 / k);
@@ -363,12 +391,15 @@ pub fn p2p1_element(
             }
         }
 
-        let n = p2::shape(xi);
+        // τ_θθ/F_θθ = P_θθ, the hoop's first Piola stress: its virtual work is P_θθ δh_θ.
+        let tau_hoop = j * (s_dev[2] - p_h);
+        let p_hoop = tau_hoop / kin.f_hoop;
         for (a, ga) in gs.iter().enumerate() {
             for i in 0..2 {
                 let f = tau[i][0] * ga[0] + tau[i][1] * ga[1];
                 residual[2 * a + i] += w * (f - n[a] * body_force[i]);
             }
+            residual[2 * a] += w * p_hoop * hoop_shape[a];
         }
         let vol = if isochoric {
             kin.jm1 + (p_h - p_n) * inv_k
@@ -376,7 +407,7 @@ pub fn p2p1_element(
             (p_h + (resp.s[0] + resp.s[1] + resp.s[2]) / 3.0) * inv_k
         };
         // ∂p_m/∂H_jl = −⅓ tr(D ∂ε/∂H_jl), for the volume rows of a model that is not isochoric.
-        let mut dpm = [0.0; 4];
+        let mut dpm = [0.0; 5];
         if !isochoric {
             for (dp, de) in dpm.iter_mut().zip(&kin.deps) {
                 *dp = -(0..3)
@@ -396,7 +427,9 @@ pub fn p2p1_element(
             [s_hat[0][0] - s_hat[1][1], 2.0 * s_hat[0][1]],
         ];
         let rcomm = rotate(r, &comm);
-        let mut dtau = [[[0.0; 2]; 2]; 4];
+        // In-plane dτ and the hoop's dτ_θθ per H_jl, index 4 the hoop gradient h_θ.
+        let mut dtau = [[[0.0; 2]; 2]; 5];
+        let mut dtau_hoop = [0.0; 5];
         for (jl, dt) in dtau.iter_mut().enumerate() {
             let mut ds = [0.0; 4];
             for (dsi, row) in ds.iter_mut().zip(d_dev.iter()) {
@@ -407,12 +440,17 @@ pub fn p2p1_element(
                     .sum();
             }
             let rds = rotate(r, &sym(&ds));
-            let dj = j * kin.finv[jl % 2][jl / 2];
+            let dj = if jl < 4 {
+                j * kin.finv[jl % 2][jl / 2]
+            } else {
+                j / kin.f_hoop
+            };
             for i in 0..2 {
                 for k in 0..2 {
                     dt[i][k] = dj * sigma[i][k] + j * (rcomm[i][k] * kin.dtheta[jl] + rds[i][k]);
                 }
             }
+            dtau_hoop[jl] = dj * (s_dev[2] - p_h) + j * ds[2];
         }
 
         // K_(a,i),(b,jj) = w [ Σ_l (dτ/dH_{jj,l} ∇_x N_a)_i ∂N_b/∂X_l − (τ ∇_x N_b)_i (∇_x N_a)_jj ]
@@ -422,6 +460,8 @@ pub fn p2p1_element(
                 tau[1][0] * gs[bn][0] + tau[1][1] * gs[bn][1],
             ];
             for jj in 0..2 {
+                // The hoop gradient moves with the radial component only.
+                let hb = if jj == 0 { hoop_shape[bn] } else { 0.0 };
                 let mut mjb = [[0.0; 2]; 2];
                 for (l, gbl) in gb0.iter().enumerate() {
                     for i in 0..2 {
@@ -430,18 +470,31 @@ pub fn p2p1_element(
                         }
                     }
                 }
+                let mut dp_hoop = 0.0;
+                if hoop {
+                    for i in 0..2 {
+                        for k in 0..2 {
+                            mjb[i][k] += dtau[4][i][k] * hb;
+                        }
+                    }
+                    dp_hoop = (dtau_hoop[2 * jj] * gb0[0] + dtau_hoop[2 * jj + 1] * gb0[1])
+                        / kin.f_hoop
+                        + hb * (dtau_hoop[4] - p_hoop) / kin.f_hoop;
+                }
                 let col = 2 * bn + jj;
                 for (a, ga) in gs.iter().enumerate() {
                     for i in 0..2 {
                         let v = mjb[i][0] * ga[0] + mjb[i][1] * ga[1] - tgb[i] * ga[jj];
                         tangent[2 * a + i][col] += w * v;
                     }
+                    tangent[2 * a][col] += w * hoop_shape[a] * dp_hoop;
                 }
-                // K_up[(b, jj)][m] = −w J L_m (∇_x N_b)_jj; for an isochoric model K_pu is
-                // its exact transpose.
-                let dpm_b = dpm[2 * jj] * gb0[0] + dpm[2 * jj + 1] * gb0[1];
+                // K_up[(b, jj)][m] = −w J L_m ((∇_x N_b)_jj + δ_jj0 N_b/(r F_θθ)), which is
+                // ∂J/∂u_(b,jj) times −w L_m; for an isochoric model K_pu is its exact transpose.
+                let dpm_b = dpm[2 * jj] * gb0[0] + dpm[2 * jj + 1] * gb0[1] + dpm[4] * hb;
+                let dj_b = gs[bn][jj] + hb / kin.f_hoop;
                 for (m, lm) in lp.iter().enumerate() {
-                    let c = -w * j * lm * gs[bn][jj];
+                    let c = -w * j * lm * dj_b;
                     tangent[col][N_U_DOFS + m] += c;
                     tangent[N_U_DOFS + m][col] +=
                         if isochoric { c } else { w * lm * dpm_b * inv_k };

@@ -24,6 +24,8 @@
 // Matrix code indexes rows and columns together.
 #![allow(clippy::needless_range_loop)]
 
+use crate::fem::analysis::Analysis;
+
 /// C_ij = ∫_{-1}^{1} N_i(s) N_j'(s) ds for the node order [a, m, b]. Rows sum to zero (a rigid
 /// translation does not change the load); C + Cᵀ = diag(-1, 0, 1) = [N_i N_j] from -1 to 1.
 const EDGE_C: [[f64; 3]; 3] = [
@@ -61,6 +63,41 @@ pub fn edge_pressure(nodes: [[f64; 2]; 3], pressure: f64) -> EdgeLoad {
             // d f_ix / d y_j = -p C_ij, d f_iy / d x_j = p C_ij; the other entries vanish.
             tangent[2 * i][2 * j + 1] = -c;
             tangent[2 * i + 1][2 * j] = c;
+        }
+    }
+    EdgeLoad { force, tangent }
+}
+
+/// [`edge_pressure`] in the given analysis. In axisymmetry (x the radius) the pressure acts on
+/// the surface of revolution of the edge, f_i = −p ∫ N_i (x'_y, −x'_x) 2π r ds with
+/// r = Σ N_j x_j: the integrand is of degree 5 in s, so the 3-point Gauss rule is exact, and a
+/// uniform pressure on any surface of revolution sums to its exact resultant. The tangent then
+/// has, besides the turning of the normal, the growth of the ring with r.
+pub fn edge_pressure_in(analysis: Analysis, nodes: [[f64; 2]; 3], pressure: f64) -> EdgeLoad {
+    if !analysis.has_hoop() {
+        return edge_pressure(nodes, pressure);
+    }
+    let g = 0.6f64.sqrt();
+    let points = [(-g, 5.0 / 9.0), (0.0, 8.0 / 9.0), (g, 5.0 / 9.0)];
+    let mut force = [0.0; 6];
+    let mut tangent = [[0.0; 6]; 6];
+    for (s, wq) in points {
+        let n = [0.5 * s * (s - 1.0), 1.0 - s * s, 0.5 * s * (s + 1.0)];
+        let dn = [s - 0.5, -2.0 * s, s + 0.5];
+        let r: f64 = (0..3).map(|j| n[j] * nodes[j][0]).sum();
+        let dx: f64 = (0..3).map(|j| dn[j] * nodes[j][0]).sum();
+        let dy: f64 = (0..3).map(|j| dn[j] * nodes[j][1]).sum();
+        let c = -pressure * wq * analysis.measure(1.0);
+        for i in 0..3 {
+            // f_i += c N_i r (x'_y, −x'_x)
+            force[2 * i] += c * n[i] * r * dy;
+            force[2 * i + 1] -= c * n[i] * r * dx;
+            for k in 0..3 {
+                // ∂/∂x_k: r grows by N_k, x'_x by N'_k; ∂/∂y_k: x'_y grows by N'_k.
+                tangent[2 * i][2 * k] += c * n[i] * n[k] * dy;
+                tangent[2 * i][2 * k + 1] += c * n[i] * r * dn[k];
+                tangent[2 * i + 1][2 * k] -= c * n[i] * (n[k] * dx + r * dn[k]);
+            }
         }
     }
     EdgeLoad { force, tangent }
@@ -116,6 +153,79 @@ mod tests {
 
     fn close(a: f64, b: f64, rel: f64) -> bool {
         (a - b).abs() <= rel * a.abs().max(b.abs())
+    }
+
+    #[test]
+    fn axisymmetric_pressure_on_a_sphere_sums_to_the_exact_force() {
+        // A sphere of radius R about the origin, meridian from the south pole to the north
+        // pole in 24 P2 edges with the midside nodes on the arc (body inside, on the left).
+        let radius = 1.7;
+        let p = 3.0e3;
+        let n = 24;
+        let at = |t: f64| [radius * t.sin(), -radius * t.cos()];
+        let mut upper = [0.0; 2];
+        let mut whole = [0.0; 2];
+        for e in 0..n {
+            let (t0, t1) = (
+                std::f64::consts::PI * e as f64 / n as f64,
+                std::f64::consts::PI * (e + 1) as f64 / n as f64,
+            );
+            // Walking from the south pole up the outside (x ≥ 0), the body is on the left.
+            let nodes = [at(t0), at(0.5 * (t0 + t1)), at(t1)];
+            let f = total(&edge_pressure_in(Analysis::Axisymmetric, nodes, p).force);
+            whole[0] += f[0];
+            whole[1] += f[1];
+            if e >= n / 2 {
+                upper[0] += f[0];
+                upper[1] += f[1];
+            }
+        }
+        // The whole sphere: no resultant. Its upper half: the pressure on the projected disc.
+        assert!(whole[1].abs() <= 1e-10 * p * radius * radius, "{whole:?}");
+        let exact = -p * std::f64::consts::PI * radius * radius;
+        assert!(
+            (upper[1] - exact).abs() <= 1e-10 * exact.abs(),
+            "{} vs {exact}",
+            upper[1]
+        );
+    }
+
+    #[test]
+    fn axisymmetric_pressure_on_a_flat_annulus_is_exact() {
+        // Top face y = 0 of a body below, from r = 2 to r = 0.5 (walking −x: body on the left).
+        let nodes = [[2.0, 0.0], [1.25, 0.0], [0.5, 0.0]];
+        let f = total(&edge_pressure_in(Analysis::Axisymmetric, nodes, 10.0).force);
+        let exact = -10.0 * std::f64::consts::PI * (4.0 - 0.25);
+        assert!((f[1] - exact).abs() <= 1e-12 * exact.abs(), "{f:?}");
+        assert!(f[0].abs() <= 1e-12 * exact.abs());
+    }
+
+    #[test]
+    fn axisymmetric_tangent_matches_central_differences() {
+        let mut rng = Lcg(11);
+        for _ in 0..20 {
+            let mut e = random_edge(&mut rng);
+            for x in e.iter_mut() {
+                x[0] = x[0].abs() + 0.5;
+            }
+            let load = edge_pressure_in(Analysis::Axisymmetric, e, 2.5);
+            let h = 1e-6;
+            for k in 0..6 {
+                let (mut ep, mut em) = (e, e);
+                ep[k / 2][k % 2] += h;
+                em[k / 2][k % 2] -= h;
+                let fp = edge_pressure_in(Analysis::Axisymmetric, ep, 2.5).force;
+                let fm = edge_pressure_in(Analysis::Axisymmetric, em, 2.5).force;
+                for i in 0..6 {
+                    let fd = (fp[i] - fm[i]) / (2.0 * h);
+                    assert!(
+                        (fd - load.tangent[i][k]).abs() <= 1e-7 * (1.0 + fd.abs()),
+                        "{i} {k}: {fd} vs {}",
+                        load.tangent[i][k]
+                    );
+                }
+            }
+        }
     }
 
     #[test]

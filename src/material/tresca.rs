@@ -45,6 +45,7 @@
 
 use super::elastic::LinearElastic;
 use super::layout::{grew, internal_len};
+use super::mohr_coulomb::MohrCoulomb;
 use super::{GaussState, InternalVar, Material, MaterialError, MaterialResponse};
 
 /// The internal variables: the accumulated plastic strain (engineering shear) and its
@@ -93,6 +94,9 @@ pub struct Tresca {
     /// E / cu at every point (offshore practice: stiffness grows with strength), instead of one
     /// `young`; None: E = `young` everywhere.
     pub young_over_cu: Option<f64>,
+    /// Judged in full principal stresses, σzz among them ([`Tresca::in_principal_stresses`]);
+    /// false: the in-plane criterion of the module docs.
+    pub principal: bool,
 }
 
 /// Deviatoric projector on Voigt vectors, engineering shear on the strain side (tensor shear
@@ -132,7 +136,21 @@ impl Tresca {
             cu,
             profile: None,
             young_over_cu: None,
+            principal: false,
         })
+    }
+
+    /// The same material judged in full principal stresses: (σ1 − σ3)/2 = cu with σzz among
+    /// them, by the Mohr–Coulomb return at φ = ψ = 0 (face, edge and corner returns of the
+    /// hexagonal prism, the consistent tangent of [`super::mohr_coulomb`]). Axisymmetry needs
+    /// it: there σzz is the hoop stress, which can be the largest or the smallest, and plastic
+    /// flow strains the hoop. In plane strain the in-plane criterion stays the default, since
+    /// it holds the textbook collapse loads exactly from the first plastic step.
+    pub fn in_principal_stresses(self) -> Self {
+        Self {
+            principal: true,
+            ..self
+        }
     }
 
     /// The same material with a strength profile: each point's cu is set from the height `y` it
@@ -276,6 +294,9 @@ impl Tresca {
         state_n: &GaussState,
         e: &[f64; 4],
     ) -> Result<MaterialResponse, MaterialError> {
+        if self.principal {
+            return self.principal_return(state_n, e);
+        }
         // The elastic trial state is the linear-elastic update (which also rejects bad strains).
         let trial = LinearElastic {
             young: self.young,
@@ -321,6 +342,35 @@ impl Tresca {
         Ok(MaterialResponse {
             s,
             d: self.tangent(beta, Some(&n)),
+            state,
+        })
+    }
+}
+
+impl Tresca {
+    /// The return in full principal stresses: Mohr–Coulomb at φ = ψ = 0 with c = cu. Its
+    /// internal variables are this model's first ones (the plastic strain, `eps_q`) in the
+    /// same layout; a strength profile's `cu` after them is kept.
+    fn principal_return(
+        &self,
+        state_n: &GaussState,
+        e: &[f64; 4],
+    ) -> Result<MaterialResponse, MaterialError> {
+        let cu = self.strength_of(state_n);
+        let prism = MohrCoulomb::new(self.young, self.poisson, cu, 0.0, 0.0, None)?;
+        let shared = internal_len(&VARIABLES);
+        let mut head = state_n.clone();
+        head.internal.truncate(shared);
+        let out = prism.update(&head, e)?;
+        let mut state = state_n.clone();
+        let len = internal_len(self.internal_variables());
+        if state.internal.len() != len {
+            state.internal.resize(len, 0.0);
+        }
+        state.internal[..shared].copy_from_slice(&out.state.internal[..shared]);
+        Ok(MaterialResponse {
+            s: out.s,
+            d: out.d,
             state,
         })
     }

@@ -57,7 +57,9 @@ impl Simulation {
             .map(|(i, e)| ((e[0], e[1]), (n_vertex + i) as u32))
             .collect();
         // Boundary edges with their nodes [a, m, b] and start length.
-        let mut edges: Vec<([u32; 3], [f64; 2], f64, f64)> = Vec::new();
+        // (nodes, midpoint, the nodes' weights, spacing) of every boundary edge.
+        let mut edges: Vec<([u32; 3], [f64; 2], [f64; 3], f64)> = Vec::new();
+        let analysis = model.scene.analysis;
         for e in &mesh.boundary_edges {
             let [a, b] = *e;
             let (ga, gb) = (mesh.gids[a as usize], mesh.gids[b as usize]);
@@ -70,10 +72,24 @@ impl Simulation {
             let (xa, xb) = (mesh.points[a as usize], mesh.points[b as usize]);
             let len = ((xb[0] - xa[0]).powi(2) + (xb[1] - xa[1]).powi(2)).sqrt();
             let mid = [0.5 * (xa[0] + xb[0]), 0.5 * (xa[1] + xb[1])];
+            // The length (axisymmetry: the ring area) each node stands for, by Simpson's rule,
+            // which is exact on a straight edge. A node on the axis stands for no area; it
+            // carries its force R all the same, and the length of a ring an eighth of the edge
+            // out only scales its pressure in the contact decision.
+            let simpson = simpson_weights(len);
+            let ring = |x: [f64; 2]| {
+                let r = if x[0] > model.tol { x[0] } else { 0.125 * len };
+                analysis.measure(r)
+            };
+            let weights = [
+                ring(xa) * simpson[0],
+                ring(mid) * simpson[1],
+                ring(xb) * simpson[2],
+            ];
             edges.push((
                 [na, m, nb],
                 mid,
-                len,
+                weights,
                 mesh.h[a as usize].max(mesh.h[b as usize]),
             ));
             for (k, sp) in model.scene.surface_pressure.iter().enumerate() {
@@ -110,7 +126,7 @@ impl Simulation {
             // a quarter spacing of it, plus its motion): a corner node of a platen does not
             // stand for the free side below it, whose length would add to its share of α·cu.
             let mut weight: HashMap<u32, f64> = HashMap::new();
-            for (nodes, mid, len, h) in &edges {
+            for (nodes, mid, weights, h) in &edges {
                 let margin = 0.25 * h + moved;
                 let outside_box = mid[0] < bb[0][0] - margin
                     || mid[0] > bb[1][0] + margin
@@ -119,7 +135,7 @@ impl Simulation {
                 if outside_box || shape.closest(*mid).distance > margin {
                     continue;
                 }
-                for (node, wk) in nodes.iter().zip(simpson_weights(*len)) {
+                for (node, wk) in nodes.iter().zip(weights) {
                     *weight.entry(*node).or_default() += wk;
                 }
             }

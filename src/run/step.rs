@@ -316,6 +316,7 @@ impl Simulation {
             laws: self.model.laws(to),
             tri_law,
             kernel: self.model.kernel,
+            analysis: self.model.scene.analysis,
             states_n,
             constraints: &constraints,
             point_loads,

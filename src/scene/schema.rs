@@ -13,6 +13,12 @@ use super::selector::Selector;
 pub struct Scene {
     /// Short name shown in summaries and output.
     pub name: String,
+    /// `"plane-strain"` (the default: a slice of unit thickness, forces per metre) or
+    /// `"axisymmetric"` (x is the radius r ≥ 0 and y the axis of revolution; the body must lie
+    /// at x ≥ 0, particles on the axis are held radially, and every force, reaction and
+    /// history column is for the whole circle, in N).
+    #[serde(default, skip_serializing_if = "is_plane_strain")]
+    pub analysis: crate::fem::analysis::Analysis,
     pub body: Body,
     pub mesh: Mesh,
     /// `[material]`, or several named `[[material]]` tables that `body.zones` place.
@@ -52,6 +58,10 @@ pub struct Scene {
     pub output: Output,
     #[serde(default)]
     pub solver: Solver,
+}
+
+fn is_plane_strain(a: &crate::fem::analysis::Analysis) -> bool {
+    *a == crate::fem::analysis::Analysis::PlaneStrain
 }
 
 fn is_default_contact(c: &Contact) -> bool {

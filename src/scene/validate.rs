@@ -544,6 +544,7 @@ fn check_against_particles(s: &Scene) -> Result<(), Invalid> {
 
 pub fn validate(s: &Scene) -> Result<(), Invalid> {
     check_fields(s)?;
+    super::validate_axisymmetry::check(s)?;
     super::validate_rigid::check(s)?;
     check_alignment(s)?;
     super::validate_fine::check(s)?;

@@ -195,7 +195,13 @@ fn check_rigid_modes(s: &Scene, positions: &[[f64; 2]], sel: &Sel) -> Result<(),
         let (xs, ys) = (x_heights[g], y_abscissae[g]);
         let has = |r: (f64, f64)| r.0 <= r.1;
         let spread = |r: (f64, f64)| r.1 - r.0 > tol;
-        let free = if !has(xs) && !has(ys) {
+        // A body of revolution has one rigid mode, along the axis: a radial motion strains
+        // its hoop, and the axis holds its particles radially.
+        let free = if s.analysis.has_hoop() {
+            (!has(ys)).then_some(
+                "no [[fixed]] or [[prescribed]] entry holds its y: it can slide along the axis",
+            )
+        } else if !has(xs) && !has(ys) {
             Some("nothing holds it (no [[fixed]] or [[prescribed]] particle in it)")
         } else if !has(xs) {
             Some("no [[fixed]] or [[prescribed]] entry holds its x: it can slide sideways")

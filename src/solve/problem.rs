@@ -6,10 +6,11 @@
 use super::pmg::CoarseSpace;
 use super::smoother::{element_jacobi_bound, jacobi_damping};
 use super::{Constraints, DofMap};
+use crate::fem::analysis::Analysis;
 use crate::fem::element::p2_element_with;
 use crate::fem::mixed::p2p1_element;
 use crate::fem::p2::straight_sided;
-use crate::fem::surface_load::edge_pressure;
+use crate::fem::surface_load::edge_pressure_in;
 use crate::mapping::StartStates;
 use crate::mapping::{push_states, POINTS};
 use crate::material::{GaussState, Material, Rows};
@@ -49,6 +50,8 @@ pub struct StepSetup<'a> {
     /// Index into `laws` of each local triangle.
     pub tri_law: Vec<u32>,
     pub kernel: Kernel,
+    /// Plane strain or axisymmetry: the element kernels' and the surface loads' measure.
+    pub analysis: Analysis,
     /// Cauchy state at the start of the step, per local triangle and Gauss point.
     pub states_n: &'a StartStates,
     pub constraints: &'a Constraints,
@@ -440,6 +443,7 @@ impl<'a> StepProblem<'a> {
                 &s.states_n.get(t),
                 law.material,
                 law.body_force,
+                s.analysis,
                 tangent,
             )
             .map(|e| ElementResult {
@@ -457,6 +461,7 @@ impl<'a> StepProblem<'a> {
                     law.material,
                     law.bulk,
                     law.body_force,
+                    s.analysis,
                 )
                 .map(|e| {
                     let e = e.with_pressure_scale(scale);
@@ -671,7 +676,7 @@ impl<'a> StepProblem<'a> {
     fn loads(&self, local: &[f64], mut add: impl FnMut(usize, usize, f64)) {
         for (nodes, p) in &self.setup.surface {
             let x = nodes.map(|n| self.node_position(local, n as usize));
-            let load = edge_pressure(x, *p);
+            let load = edge_pressure_in(self.setup.analysis, x, *p);
             for (j, &n) in nodes.iter().enumerate() {
                 for k in 0..2 {
                     add(n as usize, k, load.force[2 * j + k]);
@@ -754,7 +759,7 @@ impl StepProblem<'_> {
         }
         for (nodes, p) in &self.setup.surface {
             let x = nodes.map(|n| self.node_position(local, n as usize));
-            let load = edge_pressure(x, *p);
+            let load = edge_pressure_in(self.setup.analysis, x, *p);
             for (a, &na) in nodes.iter().enumerate() {
                 for i in 0..2 {
                     if !self.free(na as usize, i) {

@@ -9,6 +9,28 @@ use crate::material::tresca::{max_in_plane_shear, max_shear_3d, Tresca, EPS_Q};
 
 const CU: f64 = 2.0e4;
 
+/// The element in plane strain, as most tests here take it.
+fn p2p1_element(
+    x: &[[f64; 2]; N_NODES],
+    du: &[[f64; 2]; N_NODES],
+    p: &[f64; N_P_DOFS],
+    states_n: &[GaussState; N_GAUSS],
+    mat: &dyn Material,
+    bulk: f64,
+    body_force: [f64; 2],
+) -> Result<MixedOutput, ElementError> {
+    super::p2p1_element(
+        x,
+        du,
+        p,
+        states_n,
+        mat,
+        bulk,
+        body_force,
+        Analysis::PlaneStrain,
+    )
+}
+
 fn clay() -> Tresca {
     // E/cu = 300, ν = 0.49.
     Tresca::new(6.0e6, 0.49, CU).expect("valid parameters")
@@ -170,7 +192,7 @@ fn kinematic_derivatives_match_finite_differences() {
     // Round-off dominates below this step for the strongly distorted samples (J = 0.32).
     let step = 1e-5;
     for h in sample_gradients() {
-        let k = step_kinematics(&h).expect("valid");
+        let k = step_kinematics(&h, 0.0).expect("valid");
         let theta = |h: &Mat2| {
             let r = step_rotation(h).expect("valid");
             r[1][0].atan2(r[0][0])
@@ -207,8 +229,24 @@ fn fd_errors(
     mat: &dyn Material,
     bulk: f64,
 ) -> [f64; 4] {
+    fd_errors_in(Analysis::PlaneStrain, x, du, p, st, mat, bulk)
+}
+
+/// [`fd_errors`] in the given analysis.
+fn fd_errors_in(
+    analysis: Analysis,
+    x: &[[f64; 2]; 6],
+    du: &[[f64; 2]; 6],
+    p: &[f64; 3],
+    st: &[GaussState; 3],
+    mat: &dyn Material,
+    bulk: f64,
+) -> [f64; 4] {
     let body = [0.5e3, -2.0e4];
-    let out = p2p1_element(x, du, p, st, mat, bulk, body).expect("valid element");
+    let element = |du: &[[f64; 2]; 6], p: &[f64; 3]| {
+        super::p2p1_element(x, du, p, st, mat, bulk, body, analysis).expect("valid element")
+    };
+    let out = element(du, p);
     let mut fd = [[0.0; N_MIXED_DOFS]; N_MIXED_DOFS];
     for l in 0..N_MIXED_DOFS {
         let (mut dup, mut dum, mut pp, mut pm) = (*du, *du, *p, *p);
@@ -221,8 +259,8 @@ fn fd_errors(
             pp[l - N_U_DOFS] += hstep;
             pm[l - N_U_DOFS] -= hstep;
         }
-        let rp = p2p1_element(x, &dup, &pp, st, mat, bulk, body).expect("valid");
-        let rm = p2p1_element(x, &dum, &pm, st, mat, bulk, body).expect("valid");
+        let rp = element(&dup, &pp);
+        let rm = element(&dum, &pm);
         for k in 0..N_MIXED_DOFS {
             fd[k][l] = (rp.residual[k] - rm.residual[k]) / (2.0 * hstep);
         }
@@ -306,6 +344,87 @@ fn tangent_matches_finite_differences_plastic_prestressed_rotated() {
             let err = fd_errors(&x, &du, &p, &st, &mat, bulk);
             assert!(err.iter().all(|e| *e < 1e-6), "scale {scale}: {err:?}");
         }
+    }
+}
+
+#[test]
+fn axisymmetric_tangent_matches_finite_differences() {
+    use crate::material::mohr_coulomb::MohrCoulomb;
+    // The element lies at r = x > 0.3: the hoop terms are large.
+    let x = curved_element();
+    let st = prestress();
+    let p = [1.1e5, 1.4e5, 0.9e5];
+    let el = elastic();
+    let (l, mu) = el.lame();
+    for bulk in [l + 2.0 * mu / 3.0, f64::INFINITY] {
+        let err = fd_errors_in(
+            Analysis::Axisymmetric,
+            &x,
+            &big_step(&x, 1.0),
+            &p,
+            &st,
+            &el,
+            bulk,
+        );
+        assert!(
+            err.iter().all(|e| *e < 1e-6),
+            "elastic, bulk {bulk}: {err:?}"
+        );
+    }
+    let tresca = clay().in_principal_stresses();
+    let mc = MohrCoulomb::new(6.0e6, 0.3, 5.0e3, 30.0, 5.0, None).expect("valid");
+    let models: [(&dyn Material, f64); 2] =
+        [(&tresca, tresca.bulk_modulus()), (&mc, 6.0e6 / (3.0 * 0.4))];
+    let zero: [GaussState; 3] = std::array::from_fn(|_| GaussState::default());
+    for (mat, bulk) in models {
+        // Unconfined, so that Mohr–Coulomb flows too.
+        let (st, p) = if mat.isochoric() {
+            (&st, p)
+        } else {
+            (&zero, [0.0; 3])
+        };
+        for scale in [0.3, 0.05] {
+            let du = big_step(&x, scale);
+            let out =
+                super::p2p1_element(&x, &du, &p, st, mat, bulk, [0.0; 2], Analysis::Axisymmetric)
+                    .expect("valid");
+            assert!(
+                out.states.iter().any(|s| s.internal[EPS_Q] > 0.0),
+                "{mat:?} must flow plastically"
+            );
+            let err = fd_errors_in(Analysis::Axisymmetric, &x, &du, &p, st, mat, bulk);
+            assert!(err.iter().all(|e| *e < 1e-6), "{mat:?} {scale}: {err:?}");
+        }
+    }
+}
+
+#[test]
+fn axisymmetric_tresca_yields_on_the_hoop_stress_too() {
+    // A uniform radial stretch strains r and θ alike and leaves y: the hoop stress is one of
+    // the extremes, which the in-plane criterion cannot see.
+    let x = curved_element();
+    let zero: [GaussState; 3] = std::array::from_fn(|_| GaussState::default());
+    let mat = clay().in_principal_stresses();
+    let eps = 0.02;
+    let du = x.map(|xa| [eps * xa[0], -eps * xa[1]]);
+    let out = super::p2p1_element(
+        &x,
+        &du,
+        &[0.0; 3],
+        &zero,
+        &mat,
+        f64::INFINITY,
+        [0.0; 2],
+        Analysis::Axisymmetric,
+    )
+    .expect("valid");
+    for st in &out.states {
+        let tau = max_shear_3d(&st.stress);
+        assert!(
+            (tau - CU).abs() <= 1e-9 * CU,
+            "{tau} vs {CU}: {:?}",
+            st.stress
+        );
     }
 }
 
