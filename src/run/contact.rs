@@ -58,7 +58,8 @@ impl Simulation {
             .collect();
         // Boundary edges with their nodes [a, m, b] and start length.
         // (nodes, midpoint, the nodes' weights, spacing) of every boundary edge.
-        let mut edges: Vec<([u32; 3], [f64; 2], [f64; 3], f64)> = Vec::new();
+        type Edge = ([u32; 3], [f64; 2], [f64; 3], f64);
+        let mut edges: Vec<Edge> = Vec::new();
         let analysis = model.scene.analysis;
         for e in &mesh.boundary_edges {
             let [a, b] = *e;
