@@ -201,6 +201,8 @@ fn point_data<'a>(
         Field::VectorRef("incremental_displacement".into(), &p.increment),
         Field::Scalar("sigma_xx".into(), col(0)),
         Field::Scalar("sigma_yy".into(), col(1)),
+        // Out of the plane: σzz of plane strain, the hoop stress σθθ of axisymmetry.
+        Field::Scalar("sigma_zz".into(), col(2)),
         Field::Scalar("tau_xy".into(), col(3)),
         Field::Scalar(
             "pressure".into(),

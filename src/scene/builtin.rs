@@ -25,6 +25,10 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "footing-gradient",
         include_str!("builtin/footing-gradient.toml"),
     ),
+    (
+        "circular-footing",
+        include_str!("builtin/circular-footing.toml"),
+    ),
 ];
 
 /// TOML text of the built-in scene `name`.
