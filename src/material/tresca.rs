@@ -46,6 +46,11 @@
 use super::elastic::LinearElastic;
 use super::layout::{grew, internal_len};
 use super::mohr_coulomb::MohrCoulomb;
+use super::principal::Spectral;
+
+/// The share of the elastic stiffness Newton's tangent keeps at an edge of the Tresca prism
+/// ([`Tresca::in_principal_stresses`]).
+const EDGE_STIFFNESS: f64 = 0.05;
 use super::{GaussState, InternalVar, Material, MaterialError, MaterialResponse};
 
 /// The internal variables: the accumulated plastic strain (engineering shear) and its
@@ -362,17 +367,38 @@ impl Tresca {
         let mut head = state_n.clone();
         head.internal.truncate(shared);
         let out = prism.update(&head, e)?;
+        let mut d = out.d;
+        // At an edge of the prism (two principal stresses equal, both faces active; on the axis
+        // of an axisymmetric body σr = σθ by symmetry) the consistent tangent has no stiffness
+        // at all in the deviatoric principal plane, and a region of such points makes Newton's
+        // matrix singular. There Newton takes a share of the elastic stiffness back: the
+        // residual, and so the converged state, is exact; only the convergence rate changes.
+        if out.state.internal[EPS_Q] > head.internal.get(EPS_Q).copied().unwrap_or(0.0) {
+            let v = Spectral::of(&out.s).values;
+            let mut sorted = v;
+            sorted.sort_by(f64::total_cmp);
+            let gap = (sorted[1] - sorted[0]).min(sorted[2] - sorted[1]);
+            if gap <= 1e-9 * cu {
+                let de = LinearElastic {
+                    young: self.young,
+                    poisson: self.poisson,
+                }
+                .update(state_n, e)?
+                .d;
+                for (row, erow) in d.iter_mut().zip(de) {
+                    for (x, xe) in row.iter_mut().zip(erow) {
+                        *x += EDGE_STIFFNESS * (xe - *x);
+                    }
+                }
+            }
+        }
         let mut state = state_n.clone();
         let len = internal_len(self.internal_variables());
         if state.internal.len() != len {
             state.internal.resize(len, 0.0);
         }
         state.internal[..shared].copy_from_slice(&out.state.internal[..shared]);
-        Ok(MaterialResponse {
-            s: out.s,
-            d: out.d,
-            state,
-        })
+        Ok(MaterialResponse { s: out.s, d, state })
     }
 }
 
