@@ -29,6 +29,7 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "circular-footing",
         include_str!("builtin/circular-footing.toml"),
     ),
+    ("ball", include_str!("builtin/ball.toml")),
 ];
 
 /// TOML text of the built-in scene `name`.
