@@ -53,6 +53,10 @@
 
 #[path = "scene/builtin.rs"]
 pub mod builtin;
+
+/// The time of the steps (`steps.duration`, timed `[[rigid]]` stages).
+#[path = "scene/clock.rs"]
+pub mod clock;
 #[path = "scene/error.rs"]
 mod error;
 #[path = "scene/field_path.rs"]

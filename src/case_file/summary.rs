@@ -65,7 +65,7 @@ pub fn render(
                     num(m.young),
                     num(m.poisson)
                 );
-                if m.model == crate::scene::MaterialModel::Tresca {
+                if m.model.undrained() {
                     let _ = write!(model, ", cu = {} Pa", num(m.cu));
                     if m.cu_gradient != 0.0 {
                         let level = m.reference_level.unwrap_or(f64::NAN);

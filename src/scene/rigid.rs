@@ -76,6 +76,15 @@ pub struct Stage {
     pub to: [f64; 2],
     /// Steps the stage takes, >= 1.
     pub steps: u32,
+    /// How long the stage takes (s, > 0), its steps evenly: gives the steps a time, which a
+    /// rate-dependent material needs. Optional; not with `velocity`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duration: Option<f64>,
+    /// The body's speed along the stage (m/s, > 0): the stage lasts its travel over `velocity`.
+    /// Optional; not with `duration`. When one stage of a body is timed, all its stages are,
+    /// and only one body's stages may be, the one whose stages set the step count.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<f64>,
 }
 
 /// `[contact]`: the contact law every rigid body shares, solved inside each Newton iteration
@@ -292,10 +301,14 @@ mod tests {
                 Stage {
                     to: [0.0, -0.02],
                     steps: 50,
+                    duration: None,
+                    velocity: None,
                 },
                 Stage {
                     to: [0.08, -0.02],
                     steps: 200,
+                    duration: None,
+                    velocity: None,
                 },
             ],
             adhesion: 0.0,
