@@ -192,9 +192,12 @@ model = "tresca"
 young = 1e6
 poisson = 0.49
 cu = 1e3
+[[fixed]]
+where = "y <= 0"
+dofs = ["x", "y"]
 [[rigid]]
 name = "bar"
-circle = { centre = [0.5, 1.2], radius = 0.1 }
+circle = { centre = [0.5, 1.2], radius = 0.15 }
 stages = [{ to = [0.0, -0.02], steps = 4, velocity = 0.01 }, { to = [0.0, 0.0], steps = 2, duration = 1.0 }, { to = [0.0, 0.0], steps = 2, duration = 6.0 }]
 [history]
 columns = [{ name = "f", measure = "rigid.bar.fy" }]
