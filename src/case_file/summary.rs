@@ -91,6 +91,15 @@ pub fn render(
                         num(psi)
                     );
                 }
+                if let (Some(d), Some(x)) = (m.remoulded_ratio, m.xi95) {
+                    let _ = write!(model, ", remoulded {} cu by xi95 = {}", num(d), num(x));
+                    if let Some(h) = m.xi95_reference_spacing {
+                        let _ = write!(model, " at h = {} m (scaled h_ref/h)", num(h));
+                    }
+                }
+                if let (Some(mu), Some(r)) = (m.rate_parameter, m.reference_rate) {
+                    let _ = write!(model, ", +{} per decade above {} 1/s", num(mu), num(r));
+                }
                 if let Some(t) = m.tension_cutoff {
                     let _ = write!(model, ", tension cut-off {} Pa", num(t));
                 }
