@@ -127,7 +127,10 @@ fn two_platen_speeds_give_strengths_in_the_rate_ratio() {
     let dt_slow = 70.0 / STEPS as f64;
     let (err, plastic) = worst(&slow, |_, _| SU_REF);
     println!("slow: r/su_ref − 1 at most {err:.1e} over {plastic} plastic steps");
-    assert!(plastic >= STEPS - 2 && err < 1e-8, "slow: {plastic} steps, {err:e}");
+    assert!(
+        plastic >= STEPS - 2 && err < 1e-8,
+        "slow: {plastic} steps, {err:e}"
+    );
     assert!(slow.iter().all(|s| s.dgamma / dt_slow < gref));
     for ranks in [1, 2] {
         let fast = run(&format!("fast{ranks}"), ranks, 0.7);
@@ -148,7 +151,10 @@ fn two_platen_speeds_give_strengths_in_the_rate_ratio() {
              r/formula − 1 at most {err:.1e}, ratio off R by at most {ratio_err:.1e}",
             fast[STEPS - 1].r / slow[STEPS - 1].r
         );
-        assert!(plastic >= STEPS - 2 && err < 1e-8, "fast: {plastic} steps, {err:e}");
+        assert!(
+            plastic >= STEPS - 2 && err < 1e-8,
+            "fast: {plastic} steps, {err:e}"
+        );
         assert!(ratio_err < 1e-8, "{ratio_err:e}");
         // Two decades above the slow run, one and a bit above γ̇_ref: about 1.13.
         assert!((nominal - 1.13).abs() < 0.01, "{nominal}");
@@ -195,7 +201,10 @@ fn bad_softening_parameters_name_the_field_and_the_file() {
     let dir = workdir("soft-bad");
     fails_naming(
         &dir,
-        &["material.rate_parameter=0.1", "material.reference_rate=0.01"],
+        &[
+            "material.rate_parameter=0.1",
+            "material.reference_rate=0.01",
+        ],
         &["material.rate_parameter", "steps", "duration"],
     );
     fails_naming(

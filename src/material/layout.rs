@@ -295,7 +295,7 @@ pub fn clamp_to_bounds(vars: &[InternalVar], internal: &mut [f64]) -> bool {
     for v in vars {
         if let (VarKind::Scalar, Some(lo)) = (v.kind, lower_bound(&v.name)) {
             if let Some(x) = internal.get_mut(at) {
-                if !(*x >= lo) {
+                if (*x).partial_cmp(&lo).is_none_or(|o| o.is_lt()) {
                     *x = lo;
                     changed = true;
                 }

@@ -38,8 +38,12 @@
 //!
 //! The consistent tangent is Tresca's with the radial stiffness of the softening, and the rate
 //! factor's dependence on the strain:
+//!
+//! ```text
 //! D = K m⊗m + 2G (P_dev − P_in) + 2Gβ (P_in − N⊗N) − 2G H/(G − H) N⊗N
-//!   + G/(G − H) · √2 N ⊗ ∂su/∂ε,
+//!     + G/(G − H) · √2 N ⊗ ∂su/∂ε,
+//! ```
+//!
 //! β = su/r_tr, N the unit in-plane trial deviator, ∂su/∂ε = su_ref S μ/(ln 10 Δγ) ∂Δγ/∂ε above
 //! γ̇_ref (0 below). Without the rate term (μ = 0, or γ̇ ≤ γ̇_ref) it is symmetric: the
 //! strength is a scalar function of the multiplier and the flow associated. The rate term
@@ -460,7 +464,8 @@ impl Material for TrescaSoftening {
         let Some(su) = state.internal.get_mut(SU) else {
             return changed;
         };
-        if !(*su >= floor) {
+        // NaN included: a strength that is not at least the floor is raised to it.
+        if (*su).partial_cmp(&floor).is_none_or(|o| o.is_lt()) {
             *su = floor;
             changed = true;
         }

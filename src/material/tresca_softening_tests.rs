@@ -101,16 +101,25 @@ fn simple_shear_stress_follows_the_softening_formula() {
         let tau = st.stress[3];
         let xi = st.internal[XI];
         if xi == 0.0 {
-            assert!((tau - g() * gamma).abs() <= 1e-9 * SU_REF, "elastic inc {k}");
+            assert!(
+                (tau - g() * gamma).abs() <= 1e-9 * SU_REF,
+                "elastic inc {k}"
+            );
             continue;
         }
         plastic += 1;
         let formula = SU_REF * s_of(delta, xi, xi95);
         worst = worst.max((tau / formula - 1.0).abs());
-        assert!((xi - (gamma - tau / g())).abs() <= 1e-10 * gamma, "inc {k}: ξ");
+        assert!(
+            (xi - (gamma - tau / g())).abs() <= 1e-10 * gamma,
+            "inc {k}: ξ"
+        );
         assert!((st.internal[EPS_Q] * 3.0_f64.sqrt() - xi).abs() <= 1e-12 * xi);
         assert!((st.internal[3] - xi).abs() <= 1e-12 * xi, "γ^p_xy = ξ");
-        assert!((st.internal[SU] - tau).abs() <= 1e-12 * SU_REF, "su is the stress");
+        assert!(
+            (st.internal[SU] - tau).abs() <= 1e-12 * SU_REF,
+            "su is the stress"
+        );
         assert_eq!(st.stress[..3], [0.0; 3]);
     }
     println!("simple shear, {plastic} plastic increments: τ/formula − 1 at most {worst:.1e}");
@@ -167,7 +176,11 @@ fn the_rate_factor_multiplies_the_strength() {
     // Two rates, one decade apart, both above γ̇_ref, give strengths in the exact ratio.
     let at = |dt: f64| {
         clock(Some(dt));
-        let states = drive(&clay_rated_no_softening(mu, gref), GaussState::default(), &[[0.0, 0.0, 0.0, dg]; 10]);
+        let states = drive(
+            &clay_rated_no_softening(mu, gref),
+            GaussState::default(),
+            &[[0.0, 0.0, 0.0, dg]; 10],
+        );
         states[9].stress[3]
     };
     let (slow, fast) = (at(dg / (10.0 * gref)), at(dg / (100.0 * gref)));
@@ -183,7 +196,9 @@ fn the_rate_factor_multiplies_the_strength() {
     }
     // A zero-length increment (geostatic equilibration) has rate factor 1.
     clock(Some(0.0));
-    let r = m.update(&GaussState::default(), &[0.0, 0.0, 0.0, 10.0 * dg]).expect("ok");
+    let r = m
+        .update(&GaussState::default(), &[0.0, 0.0, 0.0, 10.0 * dg])
+        .expect("ok");
     assert!((r.state.internal[SU] - SU_REF * s_of(delta, r.state.internal[XI], xi95)).abs() < 1e-9);
 }
 
@@ -253,7 +268,10 @@ fn consistent_tangent_matches_finite_differences() {
     for e in strains {
         let err = fd_error(&m, &pre, &e);
         let r = m.update(&pre, &e).expect("ok");
-        println!("rate: {e:?}: tangent vs FD {err:.1e}, asymmetry {:.1e}", asymmetry(&r.d));
+        println!(
+            "rate: {e:?}: tangent vs FD {err:.1e}, asymmetry {:.1e}",
+            asymmetry(&r.d)
+        );
         assert!(err < 1e-6, "{e:?}: {err:e}");
     }
     let r = m.update(&pre, &strains[3]).expect("ok");
@@ -267,7 +285,9 @@ fn consistent_tangent_matches_finite_differences() {
 fn regularisation_scales_xi95_with_the_element_size() {
     clock(None);
     let h_ref = 0.1;
-    let m = clay(0.3, 0.05).with_reference_spacing(h_ref).expect("valid");
+    let m = clay(0.3, 0.05)
+        .with_reference_spacing(h_ref)
+        .expect("valid");
     let plain_2x = clay(0.3, 0.1);
     // A right isosceles triangle of legs h has size √(2 · h²/2) = h.
     let h = 0.05;

@@ -104,8 +104,7 @@ pub fn check(s: &Scene) -> Result<(), Invalid> {
                 (None, Some(_)) if travel == 0.0 => {
                     return Err((
                         at.join("velocity"),
-                        "times a stage that does not move the body: give its duration"
-                            .to_string(),
+                        "times a stage that does not move the body: give its duration".to_string(),
                     ))
                 }
                 (None, None) => untimed = untimed.or(Some(k)),
@@ -219,12 +218,16 @@ columns = [{ name = "f", measure = "rigid.bar.fy" }]
 
     #[test]
     fn a_whole_run_duration_is_spread_evenly() {
-        let toml = TBAR.replace(", velocity = 0.01", "").replace(", duration = 1.0", "");
+        let toml = TBAR
+            .replace(", velocity = 0.01", "")
+            .replace(", duration = 1.0", "");
         let toml = toml.replace(", duration = 6.0", "") + "[steps]\nduration = 16.0\n";
         let s = Scene::from_toml(&toml, "t.toml", &[]).expect("valid");
         assert!((time_at(&s, 0.25).unwrap() - 4.0).abs() < 1e-15);
         let none = TBAR.replace(", velocity = 0.01", "");
-        let none = none.replace(", duration = 1.0", "").replace(", duration = 6.0", "");
+        let none = none
+            .replace(", duration = 1.0", "")
+            .replace(", duration = 6.0", "");
         let s = Scene::from_toml(&none, "t.toml", &[]).expect("valid");
         assert!(!timed(&s) && time_at(&s, 0.5).is_none());
     }
@@ -232,9 +235,17 @@ columns = [{ name = "f", measure = "rigid.bar.fy" }]
     #[test]
     fn bad_timing_names_the_field() {
         for (from, to, field) in [
-            (", velocity = 0.01", ", velocity = -1.0", "rigid[0].stages[0].velocity"),
+            (
+                ", velocity = 0.01",
+                ", velocity = -1.0",
+                "rigid[0].stages[0].velocity",
+            ),
             (", duration = 1.0", "", "rigid[0].stages[1]"),
-            (", duration = 1.0", ", duration = 0.0", "rigid[0].stages[1].duration"),
+            (
+                ", duration = 1.0",
+                ", duration = 0.0",
+                "rigid[0].stages[1].duration",
+            ),
             (
                 ", duration = 6.0",
                 ", velocity = 1.0",
@@ -245,11 +256,21 @@ columns = [{ name = "f", measure = "rigid.bar.fy" }]
                 ", duration = 1.0, velocity = 2.0",
                 "rigid[0].stages[1].velocity",
             ),
-            ("[history]", "[steps]\nduration = 3.0\n[history]", "steps.duration"),
-            ("[history]", "[steps]\nduration = -3.0\n[history]", "steps.duration"),
+            (
+                "[history]",
+                "[steps]\nduration = 3.0\n[history]",
+                "steps.duration",
+            ),
+            (
+                "[history]",
+                "[steps]\nduration = -3.0\n[history]",
+                "steps.duration",
+            ),
         ] {
             let toml = TBAR.replace(from, to);
-            let err = Scene::from_toml(&toml, "t.toml", &[]).expect_err(field).to_string();
+            let err = Scene::from_toml(&toml, "t.toml", &[])
+                .expect_err(field)
+                .to_string();
             assert!(err.contains(field), "{field}: {err}");
         }
     }

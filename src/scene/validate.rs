@@ -747,7 +747,11 @@ fn foreign_keys(m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
             m.cu != 0.0,
             &[Tresca, TrescaSoftening, LinearElastic, Umat],
         ),
-        ("cu_gradient", m.cu_gradient != 0.0, &[Tresca, TrescaSoftening]),
+        (
+            "cu_gradient",
+            m.cu_gradient != 0.0,
+            &[Tresca, TrescaSoftening],
+        ),
         (
             "reference_level",
             m.reference_level.is_some(),
