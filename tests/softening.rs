@@ -241,3 +241,45 @@ fn bad_softening_parameters_name_the_field_and_the_file() {
         &["material.remoulded_ratio", "tresca-softening"],
     );
 }
+
+/// Nc of the first `steps` steps of the built-in `tbar-softening` with `sets`, coarsened around
+/// the bar (h = 0.01 there) to keep the test short.
+fn tbar(dir: &Path, name: &str, steps: u32, sets: &[&str]) -> Vec<f64> {
+    let case = format!("{name}.h5");
+    let coarse = "mesh.fine=[{ origin = [0.0, 0.2], size = [0.16, 0.36], h = 0.01 }]";
+    let mut args = vec!["new", "tbar-softening", "-o", &case, "--set", coarse];
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    ok(dir, 1, &args);
+    let until = steps.to_string();
+    ok(dir, 1, &[&case, "--out", name, "--until-step", &until]);
+    let (header, rows) = history(&dir.join(name).join("history.csv"));
+    assert_eq!(header, ["step", "w_over_D", "Nc"]);
+    rows.iter().map(|r| r[2]).collect()
+}
+
+#[test]
+fn tbar_softening_takes_its_time_from_the_stage_velocity() {
+    // The stages' 20 mm/s give the steps 0.075 s each, and the clay near the bar is sheared
+    // faster than γ̇_ref = v/D: its resistance is above the rate-independent one. Halving the
+    // speed (0.15 s a step) lowers it again; without time the scene is refused.
+    let dir = workdir("tbar-soft");
+    let fast = tbar(&dir, "fast", 6, &[]);
+    let plain = tbar(&dir, "plain", 6, &["material.rate_parameter=0.0"]);
+    let slow_stage = "rigid[0].stages[0]={ to = [0.0, -0.06], steps = 40, velocity = 0.01 }";
+    let slow = tbar(&dir, "slow", 6, &[slow_stage]);
+    println!("Nc, 6 steps: 20 mm/s {fast:?}\n10 mm/s {slow:?}\nrate-independent {plain:?}");
+    for k in 2..6 {
+        assert!(fast[k] > slow[k] && slow[k] > plain[k], "step {}", k + 1);
+    }
+    let untimed = "rigid[0].stages[0]={ to = [0.0, -0.06], steps = 40 }";
+    let out = run(
+        &dir,
+        1,
+        &["new", "tbar-softening", "-o", "bad.h5", "--set", untimed],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(stderr.contains("rigid[0].stages[0]"), "{stderr}");
+}

@@ -800,8 +800,10 @@ impl Simulation {
         } else {
             self.header.load_factor += solved.dlambda;
         }
-        // The analysis is quasi-static: its time is the load factor, as the XDMF frames' is.
-        self.header.time = self.header.load_factor;
+        // The scene's time in seconds where it gives one (`scene::clock`), else the load factor
+        // (a quasi-static analysis): history's `time` and the XDMF frames read it.
+        let lf = self.header.load_factor;
+        self.header.time = self.model.seconds_at(lf).unwrap_or(lf);
         Ok(StepReport {
             newton_iterations: solved.newton_iterations,
             linear_iterations: solved.linear_iterations,

@@ -190,7 +190,8 @@ pub struct Probe {
 
 /// `[[history.columns]]`: one column of `history.csv`, `scale * measure`.
 ///
-/// Measures: `load_factor`, `time`, `area` (body area, m²), `probe.NAME.ux|uy`,
+/// Measures: `load_factor`, `time` (s, when the scene gives its steps a time: `steps.duration`
+/// or timed `[[rigid]]` stages; else the load factor), `area` (body area, m²), `probe.NAME.ux|uy`,
 /// `rigid.NAME.ux|uy` (the body's displacement), `rigid.NAME.fx|fy` (the force the soil puts on
 /// the body: the sum of the contact tractions, N/m), `reaction.NAME.fx|fy` (the force on the
 /// particles of a named `[[fixed]]` or `[[prescribed]]` set).
