@@ -473,7 +473,8 @@ impl Material for TrescaSoftening {
         let s = &mut state.stress;
         let a = 0.5 * (s[0] - s[1]);
         let r = a.hypot(s[3]);
-        if r > su {
+        // On the surface to round-off (a converged state, rotated by the element): admissible.
+        if r > su * (1.0 + 1e-12) {
             let shrink = 1.0 - su / r;
             s[0] -= shrink * a;
             s[1] += shrink * a;
