@@ -3,7 +3,11 @@
 //! that survived unchanged keeps its Gauss states exactly, and a new triangle interpolates the
 //! particle values at its Gauss points. Both directions reproduce linear fields exactly. Every
 //! column of the material's layout is transferred alike, so the layout's width is all this
-//! module knows of it.
+//! module knows of it. The run then returns the recovered particle states, and the interpolated
+//! Gauss states, to their material's admissible set ([`crate::material::Material::admit`]:
+//! eps_q, ξ ≥ 0, the stress on or inside the yield surface): the recovery's extrapolation
+//! overshoots where the field is not linear (issue 28 item 5). An admissible state is left as it
+//! is, so the exactness for linear fields holds wherever the linear field is admissible.
 
 use crate::fem::element::p2_gauss_points;
 use crate::fem::p2::straight_sided;
@@ -114,6 +118,8 @@ pub struct MapStats {
     pub interpolated: usize,
     /// Interpolated triangles this rank owns (a sum over ranks counts each triangle once).
     pub interpolated_owned: usize,
+    /// Interpolated triangles whose states were returned to admissibility.
+    pub admitted: usize,
 }
 
 /// States for `mesh`'s triangles: kept where the triangle existed before (same three global
@@ -124,6 +130,18 @@ pub struct MapStats {
 /// less, but a rank does not hold every old triangle around its ghost triangles, so copies could
 /// differ.)
 pub fn map_states(old: &TriStates, mesh: &LocalMesh, at_points: &Rows) -> (Rows, MapStats) {
+    map_states_admitted(old, mesh, at_points, |_, _| false)
+}
+
+/// [`map_states`], with `admit(t, row)` returning the interpolated Gauss states of triangle `t`
+/// (its row of [`POINTS`] layout rows) to its material's admissible set
+/// ([`crate::material::Material::admit`]); kept triangles are not touched.
+pub fn map_states_admitted(
+    old: &TriStates,
+    mesh: &LocalMesh,
+    at_points: &Rows,
+    mut admit: impl FnMut(usize, &mut [f64]) -> bool,
+) -> (Rows, MapStats) {
     let w = at_points.width();
     let mut stats = MapStats::default();
     let mut states = Rows::with_capacity(POINTS * w, mesh.tris.len());
@@ -149,9 +167,30 @@ pub fn map_states(old: &TriStates, mesh: &LocalMesh, at_points: &Rows) -> (Rows,
                 }
             }
         }
+        if admit(t, &mut row) {
+            stats.admitted += 1;
+        }
         states.push(&row);
     }
     (states, stats)
+}
+
+/// Returns each row of `rows` (one [`POINTS`] triangle row or one particle row: `points` layout
+/// rows of `state_len` each) to the admissible set of `material`; whether any changed.
+pub fn admit_rows(
+    material: &dyn crate::material::Material,
+    row: &mut [f64],
+    state_len: usize,
+) -> bool {
+    let mut changed = false;
+    for chunk in row.chunks_exact_mut(state_len) {
+        let mut st = GaussState::from_row(chunk);
+        if material.admit(&mut st) {
+            st.write_to(chunk);
+            changed = true;
+        }
+    }
+    changed
 }
 
 /// Particle values of the Gauss states: each triangle's linear extrapolation to its vertices,

@@ -7,6 +7,7 @@ use crate::material::elastic::LinearElastic;
 use crate::material::mohr_coulomb::MohrCoulomb;
 use crate::material::placed::{union_layout, Placed};
 use crate::material::tresca::{CuProfile, Tresca};
+use crate::material::tresca_softening::TrescaSoftening;
 use crate::material::umat::{self, Umat};
 use crate::material::{InternalVar, Material, MaterialError, StateLayout};
 use crate::rigid::RigidBody;
@@ -28,6 +29,9 @@ fn model_variables(m: &crate::scene::Material) -> Cow<'static, [InternalVar]> {
             &crate::material::tresca::VARIABLES_WITH_CU
         }
         MaterialModel::Tresca => &crate::material::tresca::VARIABLES,
+        MaterialModel::TrescaSoftening => {
+            crate::material::tresca_softening::variables(m.cu_gradient != 0.0)
+        }
         MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager => {
             &crate::material::mohr_coulomb::VARIABLES
         }
@@ -91,6 +95,30 @@ fn material_of(
             }
             if analysis.has_hoop() {
                 t = t.in_principal_stresses();
+            }
+            match (m.cu_gradient, m.reference_level) {
+                (k, Some(level)) if k != 0.0 => {
+                    Box::new(t.with_profile(CuProfile { gradient: k, level }))
+                }
+                _ => Box::new(t),
+            }
+        }
+        MaterialModel::TrescaSoftening => {
+            let nan = f64::NAN;
+            let mut t = TrescaSoftening::new(
+                m.young,
+                m.poisson,
+                m.cu,
+                m.remoulded_ratio.unwrap_or(nan),
+                m.xi95.unwrap_or(nan),
+                m.rate_parameter.unwrap_or(0.0),
+                m.reference_rate,
+            )?;
+            if let Some(ratio) = m.young_over_cu {
+                t = t.with_young_over_cu(ratio);
+            }
+            if let Some(h) = m.xi95_reference_spacing {
+                t = t.with_reference_spacing(h)?;
             }
             match (m.cu_gradient, m.reference_level) {
                 (k, Some(level)) if k != 0.0 => {
@@ -282,6 +310,12 @@ impl Model {
         } else {
             b
         }
+    }
+
+    /// The time (s) at load factor `lambda`, when the scene gives its steps a time
+    /// ([`crate::scene::clock`]).
+    pub fn seconds_at(&self, lambda: f64) -> Option<f64> {
+        crate::scene::clock::time_at(&self.scene, lambda)
     }
 
     /// Load factor at the end of `step` (equal increments).

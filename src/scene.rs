@@ -14,11 +14,14 @@
 //! refine = true         # particle insertion/removal (default true)
 //! smooth = false        # Laplacian smoothing of interior particles (default false)
 //! [material]
-//! model = "linear-elastic"   # or "tresca", "mohr-coulomb", "drucker-prager"
+//! model = "linear-elastic"   # or "tresca", "tresca-softening", "mohr-coulomb", "drucker-prager"
 //! young = 12.0e6             # Pa
 //! poisson = 0.2
 //! density = 0.0              # kg/m3 (default 0); body force = density * gravity.g
 //! cu = 0.0                   # Pa, undrained shear strength, "tresca" only (default 0)
+//! # "tresca-softening": cu (intact, at the reference rate), remoulded_ratio, xi95, optional
+//! # rate_parameter and reference_rate (1/s; the steps then need a time: steps.duration or
+//! # a duration/velocity on the [[rigid]] stages), xi95_reference_spacing (m)
 //! # "mohr-coulomb" and "drucker-prager": cohesion (Pa), friction_angle and dilation_angle
 //! # (degrees, dilation <= friction); tension_cutoff (Pa, "mohr-coulomb", optional);
 //! # match = "plane-strain" | "outer" | "inner" ("drucker-prager", default "plane-strain")
@@ -36,6 +39,7 @@
 //! total = [0.0, -0.1]        # m, reached at the end of loading, applied linearly
 //! [steps]
 //! count = 50
+//! # duration = 10.0         # s for the whole run (optional): a time for rate-dependent clay
 //! [history]
 //! kind = "cantilever"        # "cantilever" | "footing" | "block": history.csv columns
 //! [output]                   # optional
@@ -53,6 +57,10 @@
 
 #[path = "scene/builtin.rs"]
 pub mod builtin;
+
+/// The time of the steps (`steps.duration`, timed `[[rigid]]` stages).
+#[path = "scene/clock.rs"]
+pub mod clock;
 #[path = "scene/error.rs"]
 mod error;
 #[path = "scene/field_path.rs"]

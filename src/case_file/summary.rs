@@ -65,7 +65,7 @@ pub fn render(
                     num(m.young),
                     num(m.poisson)
                 );
-                if m.model == crate::scene::MaterialModel::Tresca {
+                if m.model.undrained() {
                     let _ = write!(model, ", cu = {} Pa", num(m.cu));
                     if m.cu_gradient != 0.0 {
                         let level = m.reference_level.unwrap_or(f64::NAN);
@@ -90,6 +90,15 @@ pub fn render(
                         num(phi),
                         num(psi)
                     );
+                }
+                if let (Some(d), Some(x)) = (m.remoulded_ratio, m.xi95) {
+                    let _ = write!(model, ", remoulded {} cu by xi95 = {}", num(d), num(x));
+                    if let Some(h) = m.xi95_reference_spacing {
+                        let _ = write!(model, " at h = {} m (scaled h_ref/h)", num(h));
+                    }
+                }
+                if let (Some(mu), Some(r)) = (m.rate_parameter, m.reference_rate) {
+                    let _ = write!(model, ", +{} per decade above {} 1/s", num(mu), num(r));
                 }
                 if let Some(t) = m.tension_cutoff {
                     let _ = write!(model, ", tension cut-off {} Pa", num(t));

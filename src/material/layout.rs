@@ -276,6 +276,36 @@ impl Rows {
     }
 }
 
+/// The lower bound of a scalar internal variable, by its name. Names mean one quantity across
+/// models (the layout of a scene with several materials merges variables by name), so the bound
+/// goes with the name: `eps_q` and `xi` are sums of non-negative increments (an accumulated
+/// equivalent, and an accumulated engineering, plastic shear strain). Others: none.
+pub fn lower_bound(name: &str) -> Option<f64> {
+    match name {
+        "eps_q" | "xi" => Some(0.0),
+        _ => None,
+    }
+}
+
+/// Raises every scalar variable of `internal` (laid out as `vars`) that is below its
+/// [`lower_bound`] (or NaN) to it; whether any changed.
+pub fn clamp_to_bounds(vars: &[InternalVar], internal: &mut [f64]) -> bool {
+    let mut at = 0;
+    let mut changed = false;
+    for v in vars {
+        if let (VarKind::Scalar, Some(lo)) = (v.kind, lower_bound(&v.name)) {
+            if let Some(x) = internal.get_mut(at) {
+                if (*x).partial_cmp(&lo).is_none_or(|o| o.is_lt()) {
+                    *x = lo;
+                    changed = true;
+                }
+            }
+        }
+        at += v.kind.width();
+    }
+    changed
+}
+
 /// The von Mises equivalent of a plastic strain increment (engineering shear in slot 3),
 /// √(2/3 Δεp:Δεp): what the `eps_q` variable of the plastic models accumulates.
 pub fn equivalent_plastic_strain(dep: &[f64]) -> f64 {
@@ -306,6 +336,22 @@ mod tests {
         assert_eq!(l.find("eps_q"), Some((8, VarKind::Scalar)));
         assert_eq!(l.find("cu"), None);
         assert_eq!(StateLayout::default().columns().len(), 4);
+    }
+
+    #[test]
+    fn accumulated_strains_are_clamped_at_zero_and_nothing_else_is() {
+        let vars = [
+            InternalVar::strain("plastic_strain"),
+            InternalVar::scalar("eps_q"),
+            InternalVar::scalar("xi"),
+            InternalVar::scalar("cu"),
+        ];
+        let mut x = [-1.0, 2.0, 0.0, -3.0, -0.5, -1e-3, -7.0];
+        assert!(clamp_to_bounds(&vars, &mut x));
+        assert_eq!(x, [-1.0, 2.0, 0.0, -3.0, 0.0, 0.0, -7.0]);
+        assert!(!clamp_to_bounds(&vars, &mut x), "admissible: unchanged");
+        let mut nan = [0.0, 0.0, 0.0, 0.0, f64::NAN, 1.0, 1.0];
+        assert!(clamp_to_bounds(&vars, &mut nan) && nan[4] == 0.0);
     }
 
     #[test]

@@ -20,6 +20,7 @@ pub mod mohr_coulomb;
 pub mod placed;
 pub mod principal;
 pub mod tresca;
+pub mod tresca_softening;
 pub mod umat;
 
 pub use layout::{InternalVar, Rows, StateLayout, VarKind, STRESS_LEN};
@@ -229,6 +230,37 @@ pub trait Material: Send + Sync + fmt::Debug {
     /// dilatant model needs.
     fn isochoric(&self) -> bool {
         false
+    }
+
+    /// Returns a state that was not computed by this model's update (recovered at a particle
+    /// by extrapolation, interpolated at a new Gauss point) to the model's admissible set;
+    /// whether it changed anything. An admissible state (its stress to 1e-12 of its size) is
+    /// left bitwise as it is, so fields the transfer reproduces exactly stay exact.
+    ///
+    /// The default: every scalar variable with a [`layout::lower_bound`] (eps_q, xi) is raised
+    /// to it, and a model that [`Material::yields`] returns the stress onto its yield surface
+    /// with its own return mapping at zero strain (Tresca: the in-plane deviator scaled onto
+    /// cu, mean stress and σzz kept; Mohr–Coulomb, Drucker–Prager: their return), keeping the
+    /// internal variables (the correction is no plastic flow). A model for which that return
+    /// is not the right correction (its strength would change with the plastic strain of the
+    /// return, or it is a plug-in) overrides this.
+    fn admit(&self, state: &mut GaussState) -> bool {
+        let mut changed = layout::clamp_to_bounds(self.internal_variables(), &mut state.internal);
+        if self.yields() {
+            if let Ok(r) = self.update(state, &[0.0; 4]) {
+                // A stress on the surface to round-off (a converged state rotated by the
+                // element) is admissible: only a return that moves it by more than 1e-12 of
+                // its size counts, so such states keep their bits.
+                let size = state.stress.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+                let moved =
+                    (r.s.iter().zip(&state.stress)).any(|(a, b)| (a - b).abs() > 1e-12 * size);
+                if moved {
+                    state.stress = r.s;
+                    changed = true;
+                }
+            }
+        }
+        changed
     }
 }
 

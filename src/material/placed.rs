@@ -162,6 +162,15 @@ impl Material for Placed {
     fn bulk_at(&self, state: &GaussState) -> Option<f64> {
         self.inner.bulk_at(&self.own(state))
     }
+
+    fn admit(&self, state: &mut GaussState) -> bool {
+        let mut own = self.own(state);
+        if !self.inner.admit(&mut own) {
+            return false;
+        }
+        *state = self.back(state, own);
+        true
+    }
 }
 
 #[cfg(test)]

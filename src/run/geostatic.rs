@@ -48,6 +48,7 @@ impl Simulation {
             let largest = max_f64(world, local);
             self.particles.state =
                 recover_at_particles(&mesh, &solved.states, &self.particles.state);
+            self.admit_particles();
             self.tri_states = TriStates::new(&mesh, solved.states);
             let reference = *first.get_or_insert(largest);
             last = if reference > 0.0 {

@@ -3,7 +3,7 @@
 use super::RunError;
 use crate::case_file::{read_checkpoint, CaseHeader};
 use crate::history::Measures;
-use crate::mapping::{map_states, StartStates, TriStates};
+use crate::mapping::{admit_rows, map_states_admitted, StartStates, TriStates};
 use crate::mesh::local::halo_width;
 use crate::mesh::LocalMesh;
 use crate::model::Model;
@@ -237,11 +237,32 @@ impl Simulation {
         if self.model.scene.mesh.remap_all {
             old = TriStates::default();
         }
-        let (states, stats) = map_states(&old, mesh, &at_points);
+        let w = self.model.layout().len();
+        let tri_law = self.triangle_materials(mesh);
+        let materials = &self.model.materials;
+        let (states, stats) = map_states_admitted(&old, mesh, &at_points, |t, row| {
+            admit_rows(materials[tri_law[t] as usize].as_ref(), row, w)
+        });
         drop(old);
         self.remapped
             .set(self.remapped.get() + stats.interpolated_owned as u64);
         StartStates::new(states)
+    }
+
+    /// Returns every owned particle's recovered state to its material's admissible set
+    /// ([`crate::material::Material::admit`]); how many changed.
+    pub(super) fn admit_particles(&mut self) -> usize {
+        let materials = &self.model.materials;
+        if !materials.iter().any(|m| m.yields()) {
+            return 0;
+        }
+        let w = self.particles.state.width();
+        let mut changed = 0;
+        for i in 0..self.particles.state.len() {
+            let m = materials[self.particles.material[i] as usize].as_ref();
+            changed += usize::from(admit_rows(m, self.particles.state.row_mut(i), w));
+        }
+        changed
     }
 
     pub(super) fn reference_position(&self, mesh: &LocalMesh, p: usize) -> [f64; 2] {

@@ -281,7 +281,10 @@ impl Simulation {
         let _ = petsc;
         let err = |e: String| SolveError::Fatal(e);
         let step = self.header.step + 1;
-        crate::material::umat::site::set_increment(step, from, to);
+        let seconds = (self.model.seconds_at(from))
+            .zip(self.model.seconds_at(to))
+            .map(|(a, b)| [a, b]);
+        crate::material::umat::site::set_increment(step, from, to, seconds);
         let tri_law = self.triangle_materials(mesh);
         let dofs = DofMap::build(world, mesh, self.model.pressure(&tri_law))
             .map_err(|e| err(e.to_string()))?;
@@ -783,6 +786,7 @@ impl Simulation {
             super::node_values::NodeValues::new(last, self.model.mixed())
                 .with_material_pressures(by_material);
         self.particles.state = recover_at_particles(mesh, &solved.states, &self.particles.state);
+        self.admit_particles();
         self.tri_states = TriStates::new(mesh, solved.states);
         self.last_reaction = solved.reaction;
         self.last_set_reactions = solved.set_reactions;
@@ -797,8 +801,10 @@ impl Simulation {
         } else {
             self.header.load_factor += solved.dlambda;
         }
-        // The analysis is quasi-static: its time is the load factor, as the XDMF frames' is.
-        self.header.time = self.header.load_factor;
+        // The scene's time in seconds where it gives one (`scene::clock`), else the load factor
+        // (a quasi-static analysis): history's `time` and the XDMF frames read it.
+        let lf = self.header.load_factor;
+        self.header.time = self.model.seconds_at(lf).unwrap_or(lf);
         Ok(StepReport {
             newton_iterations: solved.newton_iterations,
             linear_iterations: solved.linear_iterations,

@@ -15,6 +15,10 @@ pub const BUILTINS: &[(&str, &str)] = &[
     ("footing", include_str!("builtin/footing.toml")),
     ("tbar-smooth", include_str!("builtin/tbar-smooth.toml")),
     ("tbar-rough", include_str!("builtin/tbar-rough.toml")),
+    (
+        "tbar-softening",
+        include_str!("builtin/tbar-softening.toml"),
+    ),
     ("pipeline", include_str!("builtin/pipeline.toml")),
     ("vertical-cut", include_str!("builtin/vertical-cut.toml")),
     (

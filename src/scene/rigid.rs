@@ -76,6 +76,15 @@ pub struct Stage {
     pub to: [f64; 2],
     /// Steps the stage takes, >= 1.
     pub steps: u32,
+    /// How long the stage takes (s, > 0), its steps evenly: gives the steps a time, which a
+    /// rate-dependent material needs. Optional; not with `velocity`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duration: Option<f64>,
+    /// The body's speed along the stage (m/s, > 0): the stage lasts its travel over `velocity`.
+    /// Optional; not with `duration`. When one stage of a body is timed, all its stages are,
+    /// and only one body's stages may be, the one whose stages set the step count.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<f64>,
 }
 
 /// `[contact]`: the contact law every rigid body shares, solved inside each Newton iteration
@@ -181,7 +190,8 @@ pub struct Probe {
 
 /// `[[history.columns]]`: one column of `history.csv`, `scale * measure`.
 ///
-/// Measures: `load_factor`, `time`, `area` (body area, m²), `probe.NAME.ux|uy`,
+/// Measures: `load_factor`, `time` (s, when the scene gives its steps a time: `steps.duration`
+/// or timed `[[rigid]]` stages; else the load factor), `area` (body area, m²), `probe.NAME.ux|uy`,
 /// `rigid.NAME.ux|uy` (the body's displacement), `rigid.NAME.fx|fy` (the force the soil puts on
 /// the body: the sum of the contact tractions, N/m), `reaction.NAME.fx|fy` (the force on the
 /// particles of a named `[[fixed]]` or `[[prescribed]]` set).
@@ -292,10 +302,14 @@ mod tests {
                 Stage {
                     to: [0.0, -0.02],
                     steps: 50,
+                    duration: None,
+                    velocity: None,
                 },
                 Stage {
                     to: [0.08, -0.02],
                     steps: 200,
+                    duration: None,
+                    velocity: None,
                 },
             ],
             adhesion: 0.0,

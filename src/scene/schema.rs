@@ -301,6 +301,11 @@ pub enum MaterialModel {
     LinearElastic,
     /// `"tresca"`: elastic-perfectly plastic with undrained shear strength `cu`.
     Tresca,
+    /// `"tresca-softening"`: Tresca whose strength softens with the accumulated plastic shear
+    /// strain and rises with the shear strain rate (Einav & Randolph 2005): `cu` (the intact
+    /// strength at the reference rate), `remoulded_ratio`, `xi95`, optional `rate_parameter`,
+    /// `reference_rate`, `xi95_reference_spacing`.
+    TrescaSoftening,
     /// `"mohr-coulomb"`: drained, elastic-perfectly plastic: `cohesion`, `friction_angle`,
     /// `dilation_angle`, optional `tension_cutoff`.
     MohrCoulomb,
@@ -316,10 +321,16 @@ impl MaterialModel {
         match self {
             MaterialModel::LinearElastic => "linear-elastic",
             MaterialModel::Tresca => "tresca",
+            MaterialModel::TrescaSoftening => "tresca-softening",
             MaterialModel::MohrCoulomb => "mohr-coulomb",
             MaterialModel::DruckerPrager => "drucker-prager",
             MaterialModel::Umat => "umat",
         }
+    }
+
+    /// Whether the model is undrained clay with a strength `cu` (Tresca, Tresca-softening).
+    pub fn undrained(self) -> bool {
+        matches!(self, MaterialModel::Tresca | MaterialModel::TrescaSoftening)
     }
 
     /// Whether the model's strength depends on the mean stress (Mohr–Coulomb, Drucker–Prager).
@@ -416,7 +427,8 @@ pub struct Material {
     /// The name zones give in `material = "..."`; required with several materials.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
-    /// `"linear-elastic"`, `"tresca"`, `"mohr-coulomb"`, `"drucker-prager"` or `"umat"`.
+    /// `"linear-elastic"`, `"tresca"`, `"tresca-softening"`, `"mohr-coulomb"`,
+    /// `"drucker-prager"` or `"umat"`.
     pub model: MaterialModel,
     /// Young's modulus (Pa), > 0. Required, except for `"tresca"` with `young_over_cu`, where it
     /// is the stiffness at the strength `cu` (young_over_cu · cu, filled in when left out). For
@@ -429,11 +441,13 @@ pub struct Material {
     /// Mass density (kg/m3), >= 0; the body force is `density * gravity.g`. Default 0.
     #[serde(default)]
     pub density: f64,
-    /// Undrained shear strength (Pa); required > 0 for `"tresca"`, ignored otherwise. Default 0.
-    /// With `cu_gradient` it is the strength at `reference_level` and above.
+    /// Undrained shear strength (Pa); required > 0 for `"tresca"` and `"tresca-softening"` (the
+    /// intact strength at the reference rate, su_ref), ignored otherwise. Default 0. With
+    /// `cu_gradient` it is the strength at `reference_level` and above.
     #[serde(default)]
     pub cu: f64,
-    /// `"tresca"` only: strength growing with depth below `reference_level`, cu(y) = cu +
+    /// `"tresca"` and `"tresca-softening"`: strength growing with depth below `reference_level`,
+    /// cu(y) = cu +
     /// cu_gradient * (reference_level − y) (Pa/m; offshore clays: 1-2 kPa/m). Each particle
     /// keeps the strength of its initial position as it moves (an internal variable `cu` in the
     /// state and the output). Default 0 (uniform).
@@ -442,11 +456,35 @@ pub struct Material {
     /// Level (m) below which `cu_gradient` applies; required with it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference_level: Option<f64>,
-    /// `"tresca"` only: E = young_over_cu · cu at every point (offshore practice, typically
+    /// `"tresca"` and `"tresca-softening"`: E = young_over_cu · cu at every point (offshore practice, typically
     /// 100–500), so the stiffness grows with `cu_gradient` as the strength does; the mixed
     /// element's bulk modulus follows point by point. Default: one `young` everywhere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub young_over_cu: Option<f64>,
+    /// `"tresca-softening"` only: δ_rem, the remoulded strength over the intact one, in (0, 1]
+    /// (1: no softening). Required.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub remoulded_ratio: Option<f64>,
+    /// `"tresca-softening"` only: ξ95, the accumulated plastic shear strain (engineering, see
+    /// docs/guide/materials-softening.md) at which 95 % of the softening has happened, > 0.
+    /// Required.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub xi95: Option<f64>,
+    /// `"tresca-softening"` only: the element size h_ref (m, > 0) at which `xi95` holds; an
+    /// element of size h then softens with ξ95 · h_ref / h (the band regularisation that makes
+    /// the softening load–displacement curve independent of the spacing). Default: none
+    /// (`xi95` everywhere, and the result depends on the spacing).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub xi95_reference_spacing: Option<f64>,
+    /// `"tresca-softening"` only: μ, the strength's rise per decade of shear strain rate, >= 0.
+    /// Default 0 (rate-independent). With μ > 0 the steps need a duration.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate_parameter: Option<f64>,
+    /// `"tresca-softening"` only: γ̇_ref (1/s, > 0), the shear strain rate at which the
+    /// strength is `cu`; slower steps keep it (the rate factor is never below 1). Required when
+    /// `rate_parameter` > 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_rate: Option<f64>,
     /// `"mohr-coulomb"` and `"drucker-prager"`: cohesion c (Pa), >= 0 (> 0 when
     /// friction_angle = 0). Required.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -648,6 +686,13 @@ pub struct Steps {
     /// is an error. Reaching the last step without collapse is an error too. Default false.
     #[serde(default, skip_serializing_if = "is_false")]
     pub until_collapse: bool,
+    /// The run's duration in seconds (> 0), spread evenly over its steps: step k of `count`
+    /// lasts `duration / count`. A rate-dependent material (`tresca-softening` with
+    /// `rate_parameter` > 0) needs the time of its steps, from here or from a `duration` or
+    /// `velocity` on the `[[rigid]]` stages (not both); a UMAT then gets seconds as TIME and
+    /// DTIME. Default: none (the run is quasi-static, its time the load factor).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duration: Option<f64>,
     /// A load increment under which the body's largest displacement per unit load factor
     /// exceeds this multiple of the first increment's (elastic) one is a mechanism: its
     /// stiffness has fallen to 1/collapse_compliance of the initial. Collapse is the load factor
@@ -673,6 +718,7 @@ impl Default for Steps {
         Steps {
             count: 0,
             until_collapse: false,
+            duration: None,
             collapse_tolerance: default_collapse_tolerance(),
             collapse_compliance: default_collapse_compliance(),
         }

@@ -546,6 +546,7 @@ pub fn validate(s: &Scene) -> Result<(), Invalid> {
     check_fields(s)?;
     super::validate_axisymmetry::check(s)?;
     super::validate_rigid::check(s)?;
+    super::clock::check(s)?;
     check_alignment(s)?;
     super::validate_fine::check(s)?;
     check_against_particles(s)
@@ -673,14 +674,22 @@ fn check_material(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invali
     super::validate_umat::check(m, mat)?;
     match m.model {
         MaterialModel::Umat => non_negative(mat.join("cu"), m.cu),
-        MaterialModel::Tresca => {
+        MaterialModel::Tresca | MaterialModel::TrescaSoftening => {
             if !(m.cu > 0.0 && m.cu.is_finite()) {
                 return fail(
                     mat.join("cu"),
-                    format!("must be > 0 for model \"tresca\" (got {})", m.cu),
+                    format!(
+                        "must be > 0 for model \"{}\" (got {})",
+                        m.model.as_str(),
+                        m.cu
+                    ),
                 );
             }
-            cu_profile(s, m, mat)
+            cu_profile(s, m, mat)?;
+            if m.model == MaterialModel::TrescaSoftening {
+                softening(m, mat)?;
+            }
+            Ok(())
         }
         MaterialModel::LinearElastic => non_negative(mat.join("cu"), m.cu),
         MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager => {
@@ -732,11 +741,37 @@ fn check_material(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invali
 /// model's parameters.
 fn foreign_keys(m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
     use MaterialModel::*;
-    let given: [(&str, bool, &[MaterialModel]); 9] = [
-        ("cu", m.cu != 0.0, &[Tresca, LinearElastic, Umat]),
-        ("cu_gradient", m.cu_gradient != 0.0, &[Tresca]),
-        ("reference_level", m.reference_level.is_some(), &[Tresca]),
-        ("young_over_cu", m.young_over_cu.is_some(), &[Tresca]),
+    const SOFT: &[MaterialModel] = &[TrescaSoftening];
+    let given: [(&str, bool, &[MaterialModel]); 14] = [
+        (
+            "cu",
+            m.cu != 0.0,
+            &[Tresca, TrescaSoftening, LinearElastic, Umat],
+        ),
+        (
+            "cu_gradient",
+            m.cu_gradient != 0.0,
+            &[Tresca, TrescaSoftening],
+        ),
+        (
+            "reference_level",
+            m.reference_level.is_some(),
+            &[Tresca, TrescaSoftening],
+        ),
+        (
+            "young_over_cu",
+            m.young_over_cu.is_some(),
+            &[Tresca, TrescaSoftening],
+        ),
+        ("remoulded_ratio", m.remoulded_ratio.is_some(), SOFT),
+        ("xi95", m.xi95.is_some(), SOFT),
+        (
+            "xi95_reference_spacing",
+            m.xi95_reference_spacing.is_some(),
+            SOFT,
+        ),
+        ("rate_parameter", m.rate_parameter.is_some(), SOFT),
+        ("reference_rate", m.reference_rate.is_some(), SOFT),
         (
             "cohesion",
             m.cohesion.is_some(),
@@ -772,6 +807,44 @@ fn foreign_keys(m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
         }
     }
     Ok(())
+}
+
+/// The softening and rate parameters of a `"tresca-softening"` material, each checked by the
+/// model and named at fault.
+fn softening(m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
+    for (key, given) in [("remoulded_ratio", m.remoulded_ratio), ("xi95", m.xi95)] {
+        if given.is_none() {
+            return fail(
+                mat.join(key),
+                "is required for model \"tresca-softening\"".to_string(),
+            );
+        }
+    }
+    let nan = f64::NAN;
+    let checked = crate::material::tresca_softening::TrescaSoftening::new(
+        m.young,
+        m.poisson,
+        m.cu,
+        m.remoulded_ratio.unwrap_or(nan),
+        m.xi95.unwrap_or(nan),
+        m.rate_parameter.unwrap_or(0.0),
+        m.reference_rate,
+    )
+    .and_then(|t| match m.xi95_reference_spacing {
+        Some(h) => t.with_reference_spacing(h),
+        None => Ok(t),
+    });
+    match checked {
+        Err(crate::material::MaterialError::InvalidParameter {
+            name,
+            value,
+            requirement,
+        }) => fail(
+            mat.join(name),
+            format!("must satisfy {requirement} (got {value})"),
+        ),
+        _ => Ok(()),
+    }
 }
 
 /// A Tresca strength profile: a finite gradient with its reference level, and cu > 0 down to the

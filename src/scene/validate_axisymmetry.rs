@@ -4,7 +4,7 @@
 //! assumes; each is an error naming the field rather than a run that means nothing.
 
 use super::field_path::FieldPath;
-use super::schema::Scene;
+use super::schema::{MaterialModel, Scene};
 use super::validate::Invalid;
 
 /// Checks an axisymmetric scene (nothing for plane strain).
@@ -33,6 +33,23 @@ pub fn check(s: &Scene) -> Result<(), Invalid> {
                 s.gravity.g[0]
             ),
         ));
+    }
+    let all = s.material.all();
+    for (i, m) in all.iter().enumerate() {
+        if m.model == MaterialModel::TrescaSoftening {
+            let at = if all.len() == 1 {
+                FieldPath::key("material")
+            } else {
+                FieldPath::key("material").at(i)
+            };
+            return Err((
+                at.join("model"),
+                "\"tresca-softening\" judges the largest in-plane shear (plane strain) and is not \
+                 yet written in full principal stresses, which axisymmetry needs (the hoop stress \
+                 can be the largest or the smallest): use \"tresca\" or a plane-strain scene"
+                    .to_string(),
+            ));
+        }
     }
     for (i, body) in s.rigid.iter().enumerate() {
         for (j, stage) in body.stages.iter().enumerate() {

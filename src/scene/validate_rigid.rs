@@ -4,7 +4,7 @@ use std::collections::HashSet;
 
 use super::field_path::FieldPath;
 use super::rigid::Measure;
-use super::schema::{MaterialModel, Scene};
+use super::schema::Scene;
 use super::validate::Invalid;
 use crate::rigid::shape::Shape;
 
@@ -187,11 +187,11 @@ pub fn check(s: &Scene) -> Result<(), Invalid> {
                 ),
             );
         }
-        if r.adhesion > 0.0 && s.material.model != MaterialModel::Tresca {
+        if r.adhesion > 0.0 && !s.material.model.undrained() {
             return fail(
                 path.join("adhesion"),
                 "limits the interface shear to adhesion * material.cu, which needs model = \
-                 \"tresca\""
+                 \"tresca\" or \"tresca-softening\""
                     .to_string(),
             );
         }

@@ -21,9 +21,10 @@
 //!   checkpoints, halo exchange, mapping and output carry like any model's.
 //! - PNEWDT: set to 1e36 before the call; a value below 1 makes the step be cut (the call
 //!   fails as a Newton divergence does).
-//! - The analysis is one Abaqus step (KSTEP = 1) whose time is pfem-mpi's load factor: TIME(1) =
-//!   TIME(2) = the load factor at the start of the increment, DTIME its increment (a cut step's
-//!   piece), KINC = the step number. NOEL is the triangle's rank-local index + 1 (PFEM remeshes
+//! - The analysis is one Abaqus step (KSTEP = 1). Its time is the scene's in seconds when the
+//!   scene gives one (`steps.duration`, or timed `[[rigid]]` stages: [`crate::scene::clock`]),
+//!   else the load factor: TIME(1) = TIME(2) = the time at the start of the increment, DTIME
+//!   its increment (a cut step's piece), KINC = the step number. NOEL is the triangle's rank-local index + 1 (PFEM remeshes
 //!   every step, so element numbers identify nothing across steps or ranks), NPT = 1..3 the
 //!   Gauss point, COORDS its position at the start of the step, CELENT = √(2 × area) of the
 //!   triangle; LAYER = KSPT = 1; temperatures and field variables 0 (isothermal).
@@ -245,6 +246,12 @@ impl Material for Umat {
     fn yielded(&self, before: &GaussState, after: &GaussState) -> bool {
         let tail = |s: &GaussState| s.internal.get(4..).map(<[f64]>::to_vec).unwrap_or_default();
         tail(before) != tail(after)
+    }
+
+    /// Nothing: the bounds of a UMAT's state variables are its author's, and calling it outside
+    /// an increment (to return a mapped stress) is no call a UMAT expects.
+    fn admit(&self, _state: &mut GaussState) -> bool {
+        false
     }
 }
 
