@@ -53,6 +53,7 @@ pub fn render(
     match &scene {
         Ok(sc) => {
             line("scene", format!("{} (from {})", sc.name, h.scene_source));
+            line("analysis", sc.analysis.name().to_string());
             for m in sc.material.all() {
                 let mut model = match &m.name {
                     Some(n) => format!("\"{n}\": "),

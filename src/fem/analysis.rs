@@ -48,15 +48,6 @@ impl Analysis {
             Analysis::Axisymmetric => "axisymmetric",
         }
     }
-
-    /// What a force in history and reactions is per: "N/m" (per metre of length) or "N"
-    /// (the whole circle).
-    pub fn force_unit(self) -> &'static str {
-        match self {
-            Analysis::PlaneStrain => "N/m",
-            Analysis::Axisymmetric => "N",
-        }
-    }
 }
 
 /// The hoop stretch at a point of start-of-step radius `r` with radial step displacement `ur`:
