@@ -1,8 +1,10 @@
 //! Mapped states stay admissible (issue 28 item 5): after a coarse `tbar-rough` (20 steps to
 //! w = 0.5D, h = 0.01 at the bar, 1 rank) no particle's recovered accumulated plastic strain is
-//! negative and no recovered shear stress exceeds cu. Measured with the program before the
-//! change (bbe8d1c), the same run left 40 of 1 300 particles with eps_q < 0 (down to −0.043) and
-//! a recovered τ_max of 1.308 cu.
+//! negative, and no Gauss point's eps_q is negative or its shear stress above cu. Measured with
+//! the program before the change (bbe8d1c), the same run left 40 of 1 300 particles with
+//! eps_q < 0 (down to −0.043) and a recovered τ_max of 1.308 cu. The particles' recovered
+//! stresses are output as recovered (returning them too made the untuned footing of
+//! `tests/contact_untuned.rs` stop at step 4); the Gauss points made from them are admitted.
 
 mod common;
 use common::*;
@@ -54,7 +56,9 @@ for key in ("particles/state", "gauss/state"):
             .map(|x| x.parse().unwrap())
             .collect();
         assert_eq!(v[1], 0.0, "{what}: {} with eps_q < 0 (min {})", v[1], v[2]);
-        assert!(v[3] <= 1.0 + 1e-9, "{what}: tau_max/cu = {}", v[3]);
+        if what == "gauss points" {
+            assert!(v[3] <= 1.0 + 1e-9, "{what}: tau_max/cu = {}", v[3]);
+        }
         // The run did yield: the bounds bite on a plastic zone, not on an elastic body.
         assert!(v[4] > 100.0, "{what}: only {} yielded", v[4]);
     }

@@ -815,9 +815,9 @@ pub struct Solver {
     /// residual norm, more evaluations per iteration but it carries localised plastic flow
     /// further) or `"cp"`. `-snes_linesearch_type` on the command line overrides it.
     pub line_search: LineSearch,
-    /// Newton's linear solver: `"auto"` (default: direct up to 2 million global dofs and for
-    /// every `"p2p1"` mesh, iterative for larger `"p2"` meshes; measured on a 2-core machine,
-    /// the direct path was faster at every size that fits, and the limit is its memory),
+    /// Newton's linear solver: `"auto"` (default: direct up to 150 000 global dofs and for
+    /// every `"p2p1"` mesh or plastic scene, the p-multigrid for larger elastic `"p2"` meshes,
+    /// where it is the faster and leaner of the two),
     /// `"direct"` (MUMPS LU) or `"iterative"` (GMRES, or CG where `symmetric` applies, with
     /// algebraic multigrid for `"p2"`; with a Schur-complement field split, AMG on
     /// the displacements and the pressure mass matrix scaled by 1/G on the pressures, for
