@@ -195,13 +195,18 @@ pub fn p2_element_with(
             det_j: e.det_j,
         })?;
         let n = p2::shape(xi);
-        let r = p2::map_to_physical(x, xi)[0];
+        // The radius and the hoop only where there is a hoop: assembly's hot path.
+        let (r, h_hoop) = if analysis.has_hoop() {
+            let r = p2::map_to_physical(x, xi)[0];
+            let ur: f64 = n.iter().zip(du).map(|(na, ua)| na * ua[0]).sum();
+            (r, hoop_gradient(analysis, r, ur))
+        } else {
+            (1.0, 0.0)
+        };
         let w = TRI3_WEIGHTS[q] * pg.det_j * analysis.measure(r);
         let g = &pg.grad;
 
         let h = displacement_gradient(g, du);
-        let ur: f64 = n.iter().zip(du).map(|(na, ua)| na * ua[0]).sum();
-        let h_hoop = hoop_gradient(analysis, r, ur);
         let f_hoop = 1.0 + h_hoop;
         let j = jacobian_of(&h) * f_hoop;
         if !j.is_finite() || j <= 0.0 {

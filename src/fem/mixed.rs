@@ -337,18 +337,23 @@ pub fn p2p1_element(
             det_j: e.det_j,
         })?;
         let n = p2::shape(xi);
-        let radius = p2::map_to_physical(x, xi)[0];
+        let hoop = analysis.has_hoop();
+        // The radius and the hoop only where there is a hoop: assembly's hot path.
+        let (radius, h_hoop) = if hoop {
+            let radius = p2::map_to_physical(x, xi)[0];
+            let ur: f64 = n.iter().zip(du).map(|(na, ua)| na * ua[0]).sum();
+            (radius, hoop_gradient(analysis, radius, ur))
+        } else {
+            (1.0, 0.0)
+        };
         let w = TRI3_WEIGHTS[q] * pg.det_j * analysis.measure(radius);
         let gx = &pg.grad;
 
         let h = displacement_gradient(gx, du);
-        let ur: f64 = n.iter().zip(du).map(|(na, ua)| na * ua[0]).sum();
-        let h_hoop = hoop_gradient(analysis, radius, ur);
         let kin =
             step_kinematics(&h, h_hoop).map_err(|j| ElementError::Inverted { gauss: q, j })?;
         let j = kin.j;
         let r = &kin.rot;
-        let hoop = analysis.has_hoop();
         // ∂h_θ/∂u_{b,r} = N_b / r: the hoop's share of the radial columns (0 in plane strain).
         let hoop_shape: [f64; N_NODES] =
             std::array::from_fn(|a| if hoop { n[a] / radius } else { 0.0 });
@@ -430,7 +435,7 @@ pub fn p2p1_element(
         // In-plane dτ and the hoop's dτ_θθ per H_jl, index 4 the hoop gradient h_θ.
         let mut dtau = [[[0.0; 2]; 2]; 5];
         let mut dtau_hoop = [0.0; 5];
-        for (jl, dt) in dtau.iter_mut().enumerate() {
+        for (jl, dt) in dtau.iter_mut().enumerate().take(if hoop { 5 } else { 4 }) {
             let mut ds = [0.0; 4];
             for (dsi, row) in ds.iter_mut().zip(d_dev.iter()) {
                 *dsi = row
