@@ -19,6 +19,7 @@ pub mod layout;
 pub mod mohr_coulomb;
 pub mod placed;
 pub mod principal;
+pub mod rounded_prism;
 pub mod tresca;
 pub mod tresca_softening;
 pub mod umat;

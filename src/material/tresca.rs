@@ -44,8 +44,9 @@
 //! Cauchy stress), and the end-of-step Cauchy stress is on the yield surface to round-off.
 
 use super::elastic::LinearElastic;
-use super::layout::{grew, internal_len};
-use super::mohr_coulomb::MohrCoulomb;
+use super::layout::{equivalent_plastic_strain, grew, internal_len};
+use super::principal::{product, Spectral};
+use super::rounded_prism;
 use super::{GaussState, InternalVar, Material, MaterialError, MaterialResponse};
 
 /// The internal variables: the accumulated plastic strain (engineering shear) and its
@@ -141,8 +142,8 @@ impl Tresca {
     }
 
     /// The same material judged in full principal stresses: (σ1 − σ3)/2 = cu with σzz among
-    /// them, by the Mohr–Coulomb return at φ = ψ = 0 (face, edge and corner returns of the
-    /// hexagonal prism, the consistent tangent of [`super::mohr_coulomb`]). Axisymmetry needs
+    /// them, the prism's edges rounded by 1 % of cu ([`super::rounded_prism`]: 0.25 % weaker
+    /// on an edge, Tresca's to 2.5e-5 cu on a face away from them). Axisymmetry needs
     /// it: there σzz is the hoop stress, which can be the largest or the smallest, and plastic
     /// flow strains the hoop. In plane strain the in-plane criterion stays the default, since
     /// it holds the textbook collapse loads exactly from the first plastic step.
@@ -348,34 +349,52 @@ impl Tresca {
 }
 
 impl Tresca {
-    /// The return in full principal stresses: Mohr–Coulomb at φ = ψ = 0 with c = cu. Its
-    /// internal variables are this model's first ones (the plastic strain, `eps_q`) in the
-    /// same layout; a strength profile's `cu` after them is kept.
+    /// The return in full principal stresses onto the prism with rounded edges
+    /// ([`super::rounded_prism`]: on an edge, σr = σθ on the axis of a body of revolution, the
+    /// exact prism's tangent has no deviatoric stiffness and Newton stalls). Internal variables
+    /// as the in-plane return's; a strength profile's `cu` after them is kept.
     fn principal_return(
         &self,
         state_n: &GaussState,
         e: &[f64; 4],
     ) -> Result<MaterialResponse, MaterialError> {
+        let elastic = LinearElastic {
+            young: self.young,
+            poisson: self.poisson,
+        };
+        let trial = elastic.update(state_n, e)?;
         let cu = self.strength_of(state_n);
-        let prism = MohrCoulomb::new(self.young, self.poisson, cu, 0.0, 0.0, None)?;
-        let shared = internal_len(&VARIABLES);
-        let mut head = state_n.clone();
-        head.internal.truncate(shared);
-        let out = prism.update(&head, e)?;
-        // At an edge of the prism (σ1 = σ2 or σ2 = σ3 with both faces active; on the axis of
-        // an axisymmetric body σr = σθ by symmetry) this tangent has no stiffness at all in the
-        // deviatoric principal plane. Kept exact: a share of the elastic stiffness there (5 %)
-        // cured a squeezed cylinder in which every point sat on the edge, but made Newton
-        // linear near the axis of every penetration problem (a ball's first step 60 iterations
-        // instead of 16).
-        let d = out.d;
         let mut state = state_n.clone();
         let len = internal_len(self.internal_variables());
         if state.internal.len() != len {
             state.internal.resize(len, 0.0);
         }
-        state.internal[..shared].copy_from_slice(&out.state.internal[..shared]);
-        Ok(MaterialResponse { s: out.s, d, state })
+        let frame = Spectral::of(&trial.s);
+        let Some((values, dv)) =
+            rounded_prism::principal_return(&frame.values, self.shear_modulus(), cu)?
+        else {
+            return Ok(MaterialResponse {
+                s: trial.s,
+                d: trial.d,
+                state,
+            });
+        };
+        // The relief is deviatoric (the flow is), so the plastic strain is it over 2G.
+        let relief: [f64; 3] =
+            std::array::from_fn(|i| (frame.values[i] - values[i]) / (2.0 * self.shear_modulus()));
+        let dep = frame.compose_strain(&relief);
+        for (p, d) in state.internal[PLASTIC_STRAIN..PLASTIC_STRAIN + 4]
+            .iter_mut()
+            .zip(dep)
+        {
+            *p += d;
+        }
+        state.internal[EPS_Q] += equivalent_plastic_strain(&dep);
+        Ok(MaterialResponse {
+            s: frame.compose(&values),
+            d: product(&frame.isotropic_tangent(&values, &dv), &trial.d),
+            state,
+        })
     }
 }
 
