@@ -364,3 +364,40 @@ fn coarse_circular_footing_reaches_the_exact_collapse_load_on_1_and_2_ranks() {
         assert!((nc / 5.69 - 1.0).abs() <= 0.04, "{ranks} ranks: Nc = {nc}");
     }
 }
+
+#[test]
+fn coarse_ball_stays_within_4_percent_of_the_smooth_ball_factor_on_2_ranks() {
+    // The smooth ball (Randolph, Martin & Hu 2000: N_ball = 11.0) on a coarse cloud (470
+    // particles, 0.01 m at the ball, D = 0.04 m), pushed 0.12 D in 12 steps: from w/D = 0.05 the
+    // factor must lie within 4 % of 11.0 (the issue asks 6 %; measured 10.69–10.87).
+    let dir = workdir("axi-ball");
+    ok(
+        &dir,
+        1,
+        &[
+            "new",
+            "ball",
+            "-o",
+            "ball.h5",
+            "--set",
+            "mesh.h=0.04",
+            "--set",
+            "mesh.fine=[{origin=[0.0,0.24],size=[0.16,0.32],h=0.02},{origin=[0.0,0.32],size=[0.08,0.2],h=0.01}]",
+            "--set",
+            "rigid[0].stages=[{to=[0.0,-0.0048],steps=12}]",
+        ],
+    );
+    ok(&dir, 2, &["ball.h5", "--out", "r2"]);
+    let (header, rows) = history(&dir.join("r2").join("history.csv"));
+    assert_eq!(header, ["step", "w_over_D", "N_ball"]);
+    assert_eq!(rows.len(), 12);
+    for r in rows.iter().filter(|r| r[1] >= 0.05 - 1e-9) {
+        println!("w/D = {:.2}: N_ball = {:.4}", r[1], r[2]);
+        assert!(
+            (r[2] / 11.0 - 1.0).abs() <= 0.04,
+            "w/D = {}: N_ball = {}",
+            r[1],
+            r[2]
+        );
+    }
+}
