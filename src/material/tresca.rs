@@ -102,7 +102,7 @@ pub struct Tresca {
 
 /// Deviatoric projector on Voigt vectors, engineering shear on the strain side (tensor shear
 /// 2G·γ/2 = G·γ, hence ½ in the shear slot).
-const P_DEV: [[f64; 4]; 4] = [
+pub(super) const P_DEV: [[f64; 4]; 4] = [
     [2.0 / 3.0, -1.0 / 3.0, -1.0 / 3.0, 0.0],
     [-1.0 / 3.0, 2.0 / 3.0, -1.0 / 3.0, 0.0],
     [-1.0 / 3.0, -1.0 / 3.0, 2.0 / 3.0, 0.0],
@@ -111,7 +111,7 @@ const P_DEV: [[f64; 4]; 4] = [
 
 /// Projector onto the in-plane deviators spanned by (1, −1, 0, 0)/√2 and pure in-plane shear,
 /// same Voigt conventions as [`P_DEV`].
-const P_IN: [[f64; 4]; 4] = [
+pub(super) const P_IN: [[f64; 4]; 4] = [
     [0.5, -0.5, 0.0, 0.0],
     [-0.5, 0.5, 0.0, 0.0],
     [0.0, 0.0, 0.0, 0.0],
@@ -173,7 +173,7 @@ impl Tresca {
     }
 
     /// The elastic constants at a point of strength `cu`: this material, or with E = ratio · cu.
-    fn at_strength(&self, cu: f64) -> Tresca {
+    pub(super) fn at_strength(&self, cu: f64) -> Tresca {
         match self.young_over_cu {
             Some(ratio) => Tresca {
                 young: ratio * cu,
@@ -211,7 +211,7 @@ impl Tresca {
     }
 
     /// K m⊗m + 2G (P_dev − P_in) + 2Gβ (P_in − N⊗N), N⊗N omitted when `n` is `None`.
-    fn tangent(&self, beta: f64, n: Option<&[f64; 4]>) -> [[f64; 4]; 4] {
+    pub(super) fn tangent(&self, beta: f64, n: Option<&[f64; 4]>) -> [[f64; 4]; 4] {
         let k = self.bulk_modulus();
         let g2 = 2.0 * self.shear_modulus();
         let mut d = [[0.0; 4]; 4];

@@ -68,7 +68,7 @@
 
 use super::elastic::LinearElastic;
 use super::layout::{clamp_to_bounds, grew, internal_len};
-use super::tresca::CuProfile;
+use super::tresca::{CuProfile, Tresca};
 use super::umat::site;
 use super::{GaussState, InternalVar, Material, MaterialError, MaterialResponse};
 
@@ -121,16 +121,11 @@ pub struct Rate {
 /// Strain-softening, rate-dependent undrained clay; see the module docs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TrescaSoftening {
-    /// E (Pa), > 0: at the strength `cu` when `young_over_cu` is given.
-    pub young: f64,
-    /// ν in (−1, 0.5).
-    pub poisson: f64,
-    /// su_ref (Pa), > 0: the intact strength at the reference rate (at and above the profile's
-    /// level).
-    pub cu: f64,
-    pub profile: Option<CuProfile>,
-    /// E = ratio · su_ref of the point (the intact strength: the stiffness does not soften).
-    pub young_over_cu: Option<f64>,
+    /// The intact clay at the reference rate: E (at the strength `cu` when `young_over_cu` is
+    /// given; the stiffness does not soften), ν, su_ref as `cu` and its profile, with Tresca's
+    /// own checks. Only its elastic constants and strength are read: the criterion is always
+    /// the in-plane one.
+    pub intact: Tresca,
     /// δ_rem in (0, 1].
     pub remoulded_ratio: f64,
     /// ξ95 > 0.
@@ -165,10 +160,7 @@ impl TrescaSoftening {
         rate_parameter: f64,
         reference_rate: Option<f64>,
     ) -> Result<Self, MaterialError> {
-        LinearElastic::new(young, poisson)?;
-        if !(cu.is_finite() && cu > 0.0) {
-            return Err(invalid("cu", cu, "0 < cu < inf"));
-        }
+        let intact = Tresca::new(young, poisson, cu)?;
         if !(remoulded_ratio > 0.0 && remoulded_ratio <= 1.0) {
             return Err(invalid(
                 "remoulded_ratio",
@@ -203,11 +195,7 @@ impl TrescaSoftening {
             None
         };
         Ok(Self {
-            young,
-            poisson,
-            cu,
-            profile: None,
-            young_over_cu: None,
+            intact,
             remoulded_ratio,
             xi95,
             xi95_reference_spacing: None,
@@ -218,7 +206,7 @@ impl TrescaSoftening {
     /// With a strength profile (as [`super::tresca::Tresca::with_profile`]).
     pub fn with_profile(self, profile: CuProfile) -> Self {
         Self {
-            profile: Some(profile),
+            intact: self.intact.with_profile(profile),
             ..self
         }
     }
@@ -226,7 +214,7 @@ impl TrescaSoftening {
     /// With E = ratio · su_ref at every point.
     pub fn with_young_over_cu(self, ratio: f64) -> Self {
         Self {
-            young_over_cu: Some(ratio),
+            intact: self.intact.with_young_over_cu(ratio),
             ..self
         }
     }
@@ -248,25 +236,20 @@ impl TrescaSoftening {
 
     /// su_ref at initial height `y`.
     pub fn cu_at(&self, y: f64) -> f64 {
-        match self.profile {
-            Some(p) => self.cu + p.gradient * (p.level - y).max(0.0),
-            None => self.cu,
-        }
+        self.intact.cu_at(y)
     }
 
+    /// su_ref of a point: its own with a profile (at this model's offset [`CU`]).
     fn su_ref_of(&self, state: &GaussState) -> f64 {
-        match self.profile {
-            Some(_) => state.internal.get(CU).copied().unwrap_or(self.cu),
-            None => self.cu,
+        match self.intact.profile {
+            Some(_) => state.internal.get(CU).copied().unwrap_or(self.intact.cu),
+            None => self.intact.cu,
         }
     }
 
-    /// E and ν at a point of reference strength `su_ref`.
-    fn elastic_at(&self, su_ref: f64) -> LinearElastic {
-        LinearElastic {
-            young: self.young_over_cu.map_or(self.young, |k| k * su_ref),
-            poisson: self.poisson,
-        }
+    /// The intact clay's elastic constants at a point of reference strength `su_ref`.
+    fn elastic_at(&self, su_ref: f64) -> Tresca {
+        self.intact.at_strength(su_ref)
     }
 
     /// ξ95 in the element being evaluated (regularised by its size when asked to).
@@ -309,20 +292,6 @@ impl TrescaSoftening {
     }
 }
 
-/// Deviatoric and in-plane projectors, as [`super::tresca`]'s.
-const P_DEV: [[f64; 4]; 4] = [
-    [2.0 / 3.0, -1.0 / 3.0, -1.0 / 3.0, 0.0],
-    [-1.0 / 3.0, 2.0 / 3.0, -1.0 / 3.0, 0.0],
-    [-1.0 / 3.0, -1.0 / 3.0, 2.0 / 3.0, 0.0],
-    [0.0, 0.0, 0.0, 0.5],
-];
-const P_IN: [[f64; 4]; 4] = [
-    [0.5, -0.5, 0.0, 0.0],
-    [-0.5, 0.5, 0.0, 0.0],
-    [0.0, 0.0, 0.0, 0.0],
-    [0.0, 0.0, 0.0, 0.5],
-];
-
 impl Material for TrescaSoftening {
     fn update(
         &self,
@@ -330,7 +299,11 @@ impl Material for TrescaSoftening {
         e: &[f64; 4],
     ) -> Result<MaterialResponse, MaterialError> {
         let su_ref = self.su_ref_of(state_n);
-        let elastic = self.elastic_at(su_ref);
+        let clay = self.elastic_at(su_ref);
+        let elastic = LinearElastic {
+            young: clay.young,
+            poisson: clay.poisson,
+        };
         let trial = elastic.update(state_n, e)?;
         let (mut s, d_el) = (trial.s, trial.d);
         let mut state = state_n.clone();
@@ -352,7 +325,7 @@ impl Material for TrescaSoftening {
         }
 
         // F(Δλ) = r_tr − G Δλ − scale S(ξ_n + Δλ), from the perfectly plastic estimate.
-        let g = elastic.young / (2.0 * (1.0 + elastic.poisson));
+        let g = clay.shear_modulus();
         let mut dl = (r_tr - scale * self.softening(xi_n, xi95).0) / g;
         let tol = 1e-14 * r_tr;
         let mut it = 0;
@@ -397,21 +370,17 @@ impl Material for TrescaSoftening {
 
         let nrm = std::f64::consts::SQRT_2 * r_tr;
         let n = [a / nrm, -a / nrm, 0.0, tau / nrm];
-        let k = elastic.young / (3.0 * (1.0 - 2.0 * elastic.poisson));
         let g2 = 2.0 * g;
         let radial = -h / (g - h);
         // ∂su/∂ε = su_ref S(ξ_{n+1}) ∂R/∂ε = (su / R) ∂R/∂ε.
         let rate_col = g / (g - h) * std::f64::consts::SQRT_2 * su / rate;
-        let mut d = [[0.0; 4]; 4];
+        // Tresca's plastic tangent, then the softening's radial and the rate's terms.
+        let mut d = clay.tangent(beta, Some(&n));
         for (i, row) in d.iter_mut().enumerate() {
             for (j, dij) in row.iter_mut().enumerate() {
-                let vol = if i < 3 && j < 3 { k } else { 0.0 };
                 let nn = n[i] * n[j];
-                *dij = vol
-                    + g2 * (P_DEV[i][j] - P_IN[i][j])
-                    + g2 * beta * (P_IN[i][j] - nn)
-                    + g2 * radial * nn
-                    + rate_col * n[i] * drate[j];
+                *dij += g2 * radial * nn;
+                *dij += rate_col * n[i] * drate[j];
             }
         }
         Ok(MaterialResponse { s, d, state })
@@ -422,13 +391,13 @@ impl Material for TrescaSoftening {
     }
 
     fn internal_variables(&self) -> &[InternalVar] {
-        variables(self.profile.is_some())
+        variables(self.intact.profile.is_some())
     }
 
     fn initial_internal(&self, x0: [f64; 2], internal: &mut [f64]) {
         let su_ref = self.cu_at(x0[1]);
         internal[SU] = su_ref;
-        if self.profile.is_some() {
+        if self.intact.profile.is_some() {
             internal[CU] = su_ref;
         }
     }
@@ -450,10 +419,9 @@ impl Material for TrescaSoftening {
     }
 
     fn bulk_at(&self, state: &GaussState) -> Option<f64> {
-        self.young_over_cu.map(|_| {
-            let el = self.elastic_at(self.su_ref_of(state));
-            el.young / (3.0 * (1.0 - 2.0 * el.poisson))
-        })
+        self.intact
+            .young_over_cu
+            .map(|_| self.elastic_at(self.su_ref_of(state)).bulk_modulus())
     }
 
     fn admit(&self, state: &mut GaussState) -> bool {

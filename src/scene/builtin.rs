@@ -34,6 +34,10 @@ pub const BUILTINS: &[(&str, &str)] = &[
         include_str!("builtin/circular-footing.toml"),
     ),
     ("ball", include_str!("builtin/ball.toml")),
+    (
+        "footing-mohr-coulomb",
+        include_str!("builtin/footing-mohr-coulomb.toml"),
+    ),
 ];
 
 /// TOML text of the built-in scene `name`.
