@@ -401,3 +401,54 @@ fn coarse_ball_stays_within_4_percent_of_the_smooth_ball_factor_on_2_ranks() {
         );
     }
 }
+
+#[test]
+fn a_cone_tip_pushed_in_small_steps_meets_the_node_under_it() {
+    // A 60° cone (R = 0.02 m, tip rounded by 0.5 mm) on the axis, its tip 1 mm above the
+    // surface, pushed down 0.25 mm a step: from the step its tip passes the surface node on the
+    // axis, that node carries a force. (The node under a sharp tip is near the body while the
+    // midpoints of the edges beside it are not: it was left out of the contact, the tip passed
+    // through the soil and the force stayed 0.)
+    let dir = workdir("axi-cone-tip");
+    let scene = r#"
+name = "cone-tip"
+analysis = "axisymmetric"
+[body]
+rectangles = [{ origin = [0.0, 0.0], size = [0.2, 0.2] }]
+[mesh]
+h = 0.01
+alpha = 1.3
+[material]
+model = "tresca"
+young = 1.5e6
+poisson = 0.49
+cu = 5.0e3
+[[fixed]]
+where = "x >= 0.2"
+dofs = ["x"]
+[[fixed]]
+where = "y <= 0"
+dofs = ["x", "y"]
+[[rigid]]
+name = "cone"
+polygon = { vertices = [[0.0, 0.2], [0.02, 0.234641], [0.02, 0.3], [-0.02, 0.3], [-0.02, 0.234641]], corner_radius = 0.0005 }
+stages = [{ to = [0.0, -0.003], steps = 12 }]
+[history]
+columns = [{ name = "fy", measure = "rigid.cone.fy" }]
+"#;
+    let scene = scene.replace("[0.0, 0.2], [0.02", "[0.0, 0.201], [0.02");
+    let scene = scene.replace("0.234641", "0.235641");
+    let rows = run_scene(&dir, "cone", &scene, 1);
+    // The rounded tip's lowest point starts 1 mm + 0.5 mm (1/sin 30° − 1) above the surface.
+    for r in &rows {
+        let depth = r[0] * 0.00025 - 0.0015;
+        if depth > 0.0 {
+            assert!(
+                r[1] > 0.0,
+                "step {}: tip {depth} m below the surface, force {}",
+                r[0],
+                r[1]
+            );
+        }
+    }
+}

@@ -57,8 +57,9 @@ impl Simulation {
             .map(|(i, e)| ((e[0], e[1]), (n_vertex + i) as u32))
             .collect();
         // Boundary edges with their nodes [a, m, b] and start length.
-        // (nodes, midpoint, the nodes' weights, spacing) of every boundary edge.
-        type Edge = ([u32; 3], [f64; 2], [f64; 3], f64);
+        // (nodes, the nodes' positions [a, mid, b], the nodes' weights, spacing) of every
+        // boundary edge.
+        type Edge = ([u32; 3], [[f64; 2]; 3], [f64; 3], f64);
         let mut edges: Vec<Edge> = Vec::new();
         let analysis = model.scene.analysis;
         for e in &mesh.boundary_edges {
@@ -89,7 +90,7 @@ impl Simulation {
             ];
             edges.push((
                 [na, m, nb],
-                mid,
+                [xa, mid, xb],
                 weights,
                 mesh.h[a as usize].max(mesh.h[b as usize]),
             ));
@@ -127,19 +128,33 @@ impl Simulation {
             // a quarter spacing of it, plus its motion): a corner node of a platen does not
             // stand for the free side below it, whose length would add to its share of α·cu.
             let mut weight: HashMap<u32, f64> = HashMap::new();
-            for (nodes, mid, weights, h) in &edges {
+            let near = |x: &[f64; 2], h: f64| {
                 let margin = 0.25 * h + moved;
-                let outside_box = mid[0] < bb[0][0] - margin
-                    || mid[0] > bb[1][0] + margin
-                    || mid[1] < bb[0][1] - margin
-                    || mid[1] > bb[1][1] + margin;
-                if outside_box || shape.closest(*mid).distance > margin {
+                let outside_box = x[0] < bb[0][0] - margin
+                    || x[0] > bb[1][0] + margin
+                    || x[1] < bb[0][1] - margin
+                    || x[1] > bb[1][1] + margin;
+                !outside_box && shape.closest(*x).distance <= margin
+            };
+            for (nodes, xs, weights, h) in &edges {
+                if !near(&xs[1], *h) {
                     continue;
                 }
                 for (node, wk) in nodes.iter().zip(weights) {
                     *weight.entry(*node).or_default() += wk;
                 }
             }
+            // A node near the body on no such edge (under a cone's tip, where the midpoints of
+            // the edges beside it are still far off) stands for its own share of its edges.
+            let mut tips: HashMap<u32, f64> = HashMap::new();
+            for (nodes, xs, weights, h) in &edges {
+                for k in [0, 2] {
+                    if !weight.contains_key(&nodes[k]) && near(&xs[k], *h) {
+                        *tips.entry(nodes[k]).or_default() += weights[k];
+                    }
+                }
+            }
+            weight.extend(tips);
             let mut nodes: Vec<(u32, f64)> = weight
                 .into_iter()
                 .filter(|(n, _)| dofs.node_owned[*n as usize])
