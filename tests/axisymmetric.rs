@@ -331,7 +331,8 @@ fn scenes_that_break_the_symmetry_are_refused_naming_the_field() {
 }
 
 #[test]
-fn coarse_circular_footing_reaches_the_exact_collapse_load_on_1_and_2_ranks() {
+#[ignore = "coarse benchmark: circular footing against Shield's Nc on 1 and 2 ranks"]
+fn coarse_circular_footing_is_within_4_percent_of_shields_nc_on_1_and_2_ranks() {
     // Shield's smooth circular footing, Nc = 5.69 (Houlsby & Martin 2003), within 4 % on a
     // coarse cloud.
     let dir = workdir("axi-circular-footing");
