@@ -242,6 +242,7 @@ fn thick_walled_cylinder_matches_lame_through_the_loop_with_p2_and_p2p1() {
 }
 
 #[test]
+#[ignore = "slow end-to-end: a coarse circular footing on 1, 2 and 3 ranks and its restart"]
 fn an_axisymmetric_run_is_the_same_on_1_2_3_ranks_and_restarts_on_another_count() {
     // A coarse circular footing on an irregular cloud, remeshed and refined every step.
     let dir = workdir("axi-ranks");

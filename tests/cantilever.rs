@@ -18,6 +18,7 @@ fn at(rows: &[Vec<f64>], lambda: f64) -> &Vec<f64> {
 }
 
 #[test]
+#[ignore = "coarse benchmark: the default cantilever against the Reissner beam on 1, 2 and 3 ranks"]
 fn default_mesh_is_within_one_percent_and_ranks_agree() {
     let dir = workdir("cantilever");
     ok(&dir, 1, &["new", "cantilever", "-o", "c.h5"]);

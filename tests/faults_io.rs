@@ -97,7 +97,8 @@ fn files_under(dir: &Path) -> Vec<PathBuf> {
 
 /// Every file left on the disk is complete: no temporary, each checkpoint loads
 /// (`pfem-mpi info`), each frame is an HDF5 file h5py reads whole, each PNG decodes, the
-/// history parses with whole rows, the series and the scene are whole.
+/// history parses with whole rows, the run's log has whole lines, the series and the scene are
+/// whole.
 fn check_whole(work: &Path, disk: &Path) {
     for f in files_under(disk) {
         let name = f.file_name().unwrap().to_string_lossy().into_owned();
@@ -127,6 +128,12 @@ fn check_whole(work: &Path, disk: &Path) {
             let text = std::fs::read_to_string(&f).unwrap();
             assert!(text.ends_with('\n'), "{shown} ends in a partial row");
             history(&f);
+        } else if name == "run.log" {
+            let text = std::fs::read_to_string(&f).unwrap();
+            assert!(
+                text.is_empty() || text.ends_with('\n'),
+                "{shown} ends in a partial line"
+            );
         } else if name == "fields.xdmf" {
             let text = std::fs::read_to_string(&f).unwrap();
             assert!(text.trim_end().ends_with("</Xdmf>"), "{shown} is cut short");

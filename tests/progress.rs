@@ -71,6 +71,14 @@ fn without_a_terminal_stdout_has_a_line_per_5_percent_and_the_log_every_step() {
         "the log names the run first:\n{log}"
     );
     assert_eq!(step_lines(&log).len(), 40, "{log}");
+    // A run stopped short of the end shows its last step all the same.
+    let stopped = ok(&dir, 1, &["c.h5", "--out", "stopped", "--until-step", "7"]);
+    let shown = step_lines(&stopped);
+    assert!(
+        shown.last().unwrap().starts_with("step     7/40"),
+        "{stopped}"
+    );
+    assert_eq!(shown.len(), 4, "steps 2, 4, 6 and the last, 7:\n{stopped}");
     let verbose = ok(&dir, 2, &["c.h5", "--out", "verbose", "--verbose"]);
     assert_eq!(
         step_lines(&verbose).len(),

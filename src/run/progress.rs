@@ -33,8 +33,9 @@ impl PhaseTimer {
 enum Shown {
     /// A terminal: the bar, with the full lines above it under `--verbose`.
     Bar(ProgressBar),
-    /// Not a terminal (or `--progress lines`): the per-step line every `every` steps.
-    Lines { every: u64 },
+    /// Not a terminal (or `--progress lines`): the per-step line every `every` steps, and the
+    /// run's last step's (kept until the next is printed).
+    Lines { every: u64, unshown: Option<String> },
     /// `--progress json`: one object per step and one at the end, nothing else.
     Json,
 }
@@ -80,6 +81,7 @@ impl Progress {
             }
             ProgressMode::Auto | ProgressMode::Lines => Shown::Lines {
                 every: if opts.verbose { 1 } else { every(total) },
+                unshown: None,
             },
         });
         Ok(Progress {
@@ -117,7 +119,7 @@ impl Progress {
         self.newton += r.newton_iterations;
         self.linear += r.linear_iterations;
         self.contact += r.contact_seconds;
-        let Some(shown) = &self.shown else {
+        let Some(shown) = self.shown.as_mut() else {
             return;
         };
         let step = sim.step();
@@ -133,9 +135,12 @@ impl Progress {
                 bar.set_message(bar_message(sim.load_factor(), left, r, t.total()));
                 bar.set_position(step);
             }
-            Shown::Lines { every } => {
+            Shown::Lines { every, unshown } => {
                 if step.is_multiple_of(*every) || step == self.total {
                     println!("{line}");
+                    *unshown = None;
+                } else {
+                    *unshown = Some(line.clone());
                 }
             }
             Shown::Json => println!(
@@ -158,11 +163,19 @@ impl Progress {
         }
     }
 
-    /// After the last step: the bar stays, full, above the end-of-run line.
+    /// After the last step: the bar stays where it ended (a run stopped by `--until-step` or a
+    /// signal short of the end) above the end-of-run line; the lines end with the last step's,
+    /// so a script reading the output sees where the run stopped.
     pub fn finish(&mut self, sim: &Simulation) {
         let wall = self.started.elapsed().as_secs_f64();
-        if let Some(Shown::Bar(bar)) = &self.shown {
-            bar.finish();
+        match self.shown.as_mut() {
+            Some(Shown::Bar(bar)) => bar.abandon(),
+            Some(Shown::Lines { unshown, .. }) => {
+                if let Some(line) = unshown.take() {
+                    println!("{line}");
+                }
+            }
+            _ => {}
         }
         if let Some(Shown::Json) = &self.shown {
             println!(

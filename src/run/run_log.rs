@@ -12,6 +12,8 @@ pub struct RunLog {
     path: PathBuf,
     /// None once a write failed: the run goes on without its log (warned once).
     file: Option<File>,
+    /// Bytes of whole lines in the file.
+    len: u64,
 }
 
 impl RunLog {
@@ -26,26 +28,34 @@ impl RunLog {
                 path: path.clone(),
                 message: format!("cannot open the run's log: {e}"),
             })?;
+        let len = file.metadata().map(|m| m.len()).unwrap_or(0);
         Ok(RunLog {
             path,
             file: Some(file),
+            len,
         })
     }
 
     /// Appends `line` and a newline, unbuffered, so a killed run's log ends at its last line.
-    /// A log that cannot be written is not worth stopping an analysis for: one warning, then
-    /// the run continues without it.
+    /// A log that cannot be written is not worth stopping an analysis for: the part of the line
+    /// that was written is cut off again (the log keeps whole lines, as every file of a run is
+    /// whole), one warning, then the run continues without it.
     pub fn line(&mut self, line: &str) {
         let Some(file) = self.file.as_mut() else {
             return;
         };
-        if let Err(e) = file.write_all(format!("{line}\n").as_bytes()) {
-            eprintln!(
-                "pfem-mpi: warning: {}: cannot write the run's log ({e}); the run continues \
-                 without it",
-                self.path.display()
-            );
-            self.file = None;
+        let text = format!("{line}\n");
+        match file.write_all(text.as_bytes()) {
+            Ok(()) => self.len += text.len() as u64,
+            Err(e) => {
+                let _ = file.set_len(self.len);
+                eprintln!(
+                    "pfem-mpi: warning: {}: cannot write the run's log ({e}); the run continues \
+                     without it",
+                    self.path.display()
+                );
+                self.file = None;
+            }
         }
     }
 }
