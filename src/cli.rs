@@ -7,10 +7,10 @@ usage:
   pfem-mpi new <NAME|scene.toml> -o case.h5 [--set key=value ...]   write a case file
   pfem-mpi info FILE.h5                                             summarise a case or checkpoint
   pfem-mpi mesh FILE.h5                                             mesh it once, print its fingerprint
-  pfem-mpi plot DIR                                                 draw DIR/plots/*.png from a run's output
+  pfem-mpi plot DIR [--window x0,y0,x1,y1]                          draw DIR/plots/*.png from a run's output
   pfem-mpi schema                                                   print the scene reference (Markdown)
-  mpirun -n N pfem-mpi FILE.h5 [--out DIR] [--until-step K] [-- PETSc options]
-                                                                    run (or continue) an analysis
+  mpirun -n N pfem-mpi FILE.h5 [--out DIR] [--until-step K] [--progress auto|lines|json]
+                         [--verbose] [-- PETSc options]             run (or continue) an analysis
 built-in scenes:";
 
 /// The usage text, ending with every built-in scene's name.
@@ -33,17 +33,47 @@ pub enum Command {
     },
     Plot {
         dir: PathBuf,
+        /// The part of the plane the contour pictures show (metres); None: where each varies.
+        window: Option<crate::plot::Window>,
     },
     Run {
         case: PathBuf,
         out: Option<PathBuf>,
         until_step: Option<u64>,
+        progress: ProgressMode,
+        verbose: bool,
         petsc: Vec<String>,
     },
     /// Print the scene reference generated from the schema.
     Schema,
     Help,
     Version,
+}
+
+/// What a run shows on stdout while it steps (`--progress`); `DIR/run.log` gets every step's
+/// full line whatever the mode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ProgressMode {
+    /// A progress bar when stdout is a terminal, the per-step lines otherwise.
+    #[default]
+    Auto,
+    /// The per-step lines, also on a terminal.
+    Lines,
+    /// One JSON object per step (and one at the end), nothing else, on stdout.
+    Json,
+}
+
+impl ProgressMode {
+    fn parse(v: &str) -> Result<ProgressMode, String> {
+        match v {
+            "auto" => Ok(ProgressMode::Auto),
+            "lines" => Ok(ProgressMode::Lines),
+            "json" => Ok(ProgressMode::Json),
+            _ => Err(format!(
+                "--progress: {v:?} is not a progress mode; give auto, lines or json"
+            )),
+        }
+    }
 }
 
 /// Parses the arguments after the program name.
@@ -83,11 +113,23 @@ pub fn parse(args: &[String]) -> Result<Command, String> {
             })
         }
         "plot" => {
-            let [dir] = &ours[1..] else {
-                return Err("plot: give exactly one run output folder".into());
-            };
+            let mut dir = None;
+            let mut window = None;
+            let mut it = ours[1..].iter();
+            while let Some(a) = it.next() {
+                match a.as_str() {
+                    "--window" => {
+                        let w = it.next().ok_or("--window needs x0,y0,x1,y1 (metres)")?;
+                        window = Some(crate::plot::Window::parse(w)?);
+                    }
+                    s if s.starts_with('-') => return Err(format!("plot: unknown option {s}")),
+                    s if dir.is_none() => dir = Some(PathBuf::from(s)),
+                    _ => return Err("plot: give exactly one run output folder".into()),
+                }
+            }
             Ok(Command::Plot {
-                dir: PathBuf::from(dir),
+                dir: dir.ok_or("plot: give exactly one run output folder")?,
+                window,
             })
         }
         "info" | "mesh" => {
@@ -105,6 +147,8 @@ pub fn parse(args: &[String]) -> Result<Command, String> {
             let mut case = None;
             let mut out = None;
             let mut until_step = None;
+            let mut progress = ProgressMode::Auto;
+            let mut verbose = false;
             let mut it = ours.iter();
             while let Some(a) = it.next() {
                 match a.as_str() {
@@ -118,6 +162,12 @@ pub fn parse(args: &[String]) -> Result<Command, String> {
                                 format!("--until-step: {v:?} is not a step number")
                             })?);
                     }
+                    "--progress" => {
+                        progress = ProgressMode::parse(
+                            it.next().ok_or("--progress needs auto, lines or json")?,
+                        )?
+                    }
+                    "--verbose" => verbose = true,
                     s if s.starts_with('-') => {
                         return Err(format!("unknown option {s} (PETSc options go after --)"))
                     }
@@ -125,10 +175,19 @@ pub fn parse(args: &[String]) -> Result<Command, String> {
                     s => return Err(format!("unexpected argument {s}")),
                 }
             }
+            if verbose && progress == ProgressMode::Json {
+                return Err(
+                    "--verbose: stdout carries only JSON under --progress json; \
+                            the per-step lines are in DIR/run.log"
+                        .into(),
+                );
+            }
             Ok(Command::Run {
                 case: case.ok_or("no case file given")?,
                 out,
                 until_step,
+                progress,
+                verbose,
                 petsc,
             })
         }
@@ -173,9 +232,64 @@ mod tests {
                 case: "case.h5".into(),
                 out: Some("r".into()),
                 until_step: None,
+                progress: ProgressMode::Auto,
+                verbose: false,
                 petsc: args("-snes_monitor -pc_type lu")
             }
         );
+    }
+
+    #[test]
+    fn plot_with_a_window() {
+        let c = parse(&args("plot out --window 0,0.3,0.2,0.6")).unwrap();
+        let Command::Plot { dir, window } = c else {
+            panic!("{c:?}")
+        };
+        assert_eq!(dir, PathBuf::from("out"));
+        assert_eq!(window.map(|w| (w.x0, w.y1)), Some((0.0, 0.6)));
+        assert!(matches!(
+            parse(&args("plot out")),
+            Ok(Command::Plot { window: None, .. })
+        ));
+        for bad in [
+            "plot out --window",
+            "plot out --window 1,1,0,0",
+            "plot out --window a",
+        ] {
+            assert!(parse(&args(bad)).unwrap_err().contains("--window"), "{bad}");
+        }
+        assert!(parse(&args("plot a b")).is_err());
+    }
+
+    #[test]
+    fn run_with_progress_modes() {
+        let c = parse(&args("case.h5 --progress json --until-step 3")).unwrap();
+        assert!(matches!(
+            c,
+            Command::Run {
+                progress: ProgressMode::Json,
+                verbose: false,
+                until_step: Some(3),
+                ..
+            }
+        ));
+        let c = parse(&args("case.h5 --verbose --progress lines")).unwrap();
+        assert!(matches!(
+            c,
+            Command::Run {
+                progress: ProgressMode::Lines,
+                verbose: true,
+                ..
+            }
+        ));
+        for bad in ["case.h5 --progress", "case.h5 --progress bar"] {
+            assert!(
+                parse(&args(bad)).unwrap_err().contains("--progress"),
+                "{bad}"
+            );
+        }
+        let e = parse(&args("case.h5 --progress json --verbose")).unwrap_err();
+        assert!(e.contains("--verbose") && e.contains("run.log"), "{e}");
     }
 
     #[test]

@@ -33,11 +33,13 @@ pub fn execute(command: Command) -> i32 {
             }
         }
         Command::Mesh { file } => mesh(&world, &file),
-        Command::Plot { dir } => plot(&world, &dir),
+        Command::Plot { dir, window } => plot(&world, &dir, window),
         Command::Run {
             case,
             out,
             until_step,
+            progress,
+            verbose,
             petsc,
         } => {
             let out_dir = out.unwrap_or_else(|| default_out_dir(&case));
@@ -50,6 +52,8 @@ pub fn execute(command: Command) -> i32 {
                         case,
                         out_dir,
                         until_step,
+                        progress,
+                        verbose,
                     },
                 ),
                 Err(e) => Err(e.into()),
@@ -117,11 +121,15 @@ fn header_particles(set: &crate::case_file::ParticleSet) -> usize {
 }
 
 /// Rank 0 draws the pictures of a run folder.
-fn plot(world: &Comm, dir: &std::path::Path) -> Result<(), RunError> {
+fn plot(
+    world: &Comm,
+    dir: &std::path::Path,
+    window: Option<crate::plot::Window>,
+) -> Result<(), RunError> {
     if world.rank() != 0 {
         return Ok(());
     }
-    let files = crate::plot::plot_run(dir)?;
+    let files = crate::plot::plot_run_in(dir, window)?;
     for f in files {
         println!("wrote {}", f.display());
     }

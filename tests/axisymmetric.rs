@@ -244,6 +244,7 @@ fn thick_walled_cylinder_matches_lame_through_the_loop_with_p2_and_p2p1() {
 }
 
 #[test]
+#[ignore = "slow end-to-end: a coarse circular footing on 1, 2 and 3 ranks and its restart"]
 fn an_axisymmetric_run_is_the_same_on_1_2_3_ranks_and_restarts_on_another_count() {
     // A coarse circular footing on an irregular cloud, remeshed and refined every step.
     let dir = workdir("axi-ranks");
@@ -333,7 +334,8 @@ fn scenes_that_break_the_symmetry_are_refused_naming_the_field() {
 }
 
 #[test]
-fn coarse_circular_footing_reaches_the_exact_collapse_load_on_1_and_2_ranks() {
+#[ignore = "coarse benchmark: circular footing against Shield's Nc on 1 and 2 ranks"]
+fn coarse_circular_footing_is_within_4_percent_of_shields_nc_on_1_and_2_ranks() {
     // Shield's smooth circular footing, Nc = 5.69 (Houlsby & Martin 2003), within 4 % on a
     // coarse cloud.
     let dir = workdir("axi-circular-footing");

@@ -18,6 +18,7 @@ fn at(rows: &[Vec<f64>], lambda: f64) -> &Vec<f64> {
 }
 
 #[test]
+#[ignore = "coarse benchmark: the default cantilever against the Reissner beam on 1, 2 and 3 ranks"]
 fn default_mesh_is_within_one_percent_and_ranks_agree() {
     let dir = workdir("cantilever");
     ok(&dir, 1, &["new", "cantilever", "-o", "c.h5"]);
@@ -67,9 +68,22 @@ fn diverging_steps_are_cut_and_recovered() {
     let log = ok(
         &dir,
         2,
-        &["c.h5", "--out", "cut", "--", "-snes_max_it", "4"],
+        &[
+            "c.h5",
+            "--out",
+            "cut",
+            "--progress",
+            "json",
+            "--",
+            "-snes_max_it",
+            "4",
+        ],
     );
-    assert!(log.contains("(cut "), "steps should have been cut:\n{log}");
+    let cut = json_steps(&log)
+        .iter()
+        .filter(|s| s["cuts"].as_u64() > Some(0))
+        .count();
+    assert!(cut > 0, "steps should have been cut:\n{log}");
     let (_, plain) = history(&dir.join("plain/history.csv"));
     let (_, cut) = history(&dir.join("cut/history.csv"));
     assert_eq!(cut.len(), 10);

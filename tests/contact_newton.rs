@@ -61,6 +61,7 @@ fn same_histories(dir: &Path, outs: &[String], tol: f64) {
 }
 
 #[test]
+#[ignore = "coarse benchmark: a coarse rough T-bar on 1, 2 and 3 ranks"]
 fn rough_tbar_same_curve_on_one_two_three_ranks() {
     let dir = workdir("contact-newton-ranks");
     rough_tbar(&dir, &[]);

@@ -15,7 +15,8 @@ fn column(dir: &Path, out: &str, name: &str) -> Vec<f64> {
 }
 
 #[test]
-fn the_untuned_rough_footing_is_pushed_to_prandtls_load_on_one_and_two_ranks() {
+#[ignore = "coarse benchmark: untuned rough footing against Prandtl on 1 and 2 ranks"]
+fn the_untuned_rough_footing_is_within_5_percent_of_prandtls_load_on_one_and_two_ranks() {
     let dir = workdir("contact-untuned");
     std::fs::write(dir.join("untuned.toml"), SCENE).unwrap();
     ok(&dir, 1, &["new", "untuned.toml", "-o", "u.h5"]);

@@ -241,6 +241,9 @@ fn a_run_that_lost_its_body_is_an_error_not_done() {
 
 #[test]
 fn a_point_load_on_no_particle_is_an_error() {
+    if !prerequisite("Python's h5py (python3-h5py)", python_has("h5py")) {
+        return;
+    }
     let dir = workdir("faults-lost-load");
     small_cantilever(&dir, 2, &["mesh.h=0.5"]);
     // The tracked particle renamed to an id no particle has: the load was dropped silently.

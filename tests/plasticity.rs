@@ -12,19 +12,26 @@ fn block_compression_holds_two_cu_and_the_volume() {
     ok(&dir, 1, &["new", "block-compression", "-o", "b.h5"]);
     for ranks in [1, 2, 3] {
         let out = format!("r{ranks}");
-        let log = ok(&dir, ranks, &["b.h5", "--out", &out]);
+        let steps = json_steps(&ok(
+            &dir,
+            ranks,
+            &["b.h5", "--out", &out, "--progress", "json"],
+        ));
+        assert_eq!(steps.len(), 100, "one object a step");
         // The lattice is split as it stretches, so the mapping is exercised, not just skipped.
+        let particles: Vec<u64> = steps
+            .iter()
+            .filter_map(|s| s["particles"].as_u64())
+            .collect();
         assert!(
-            log.contains("particles 121 ") && log.contains("particles 241 "),
-            "refinement should take the block from 121 to 241 particles"
+            particles.contains(&121) && particles.contains(&241),
+            "refinement should take the block from 121 to 241 particles: {particles:?}"
         );
         // Between the splits the homogeneously compressed lattice keeps its mesh: no triangle is
         // remapped (round-off used to flip its cocircular cells' diagonals every step).
-        let line = log
-            .lines()
-            .find(|l| l.starts_with("step    50/100"))
-            .expect("a progress line for step 50");
-        assert!(line.contains(" remapped 0 "), "{line}");
+        let step50 = &steps[49];
+        assert_eq!(step50["step"], 50);
+        assert_eq!(step50["remapped"], 0, "{step50}");
         let (header, rows) = history(&dir.join(&out).join("history.csv"));
         assert_eq!(header, ["step", "strain", "stress_over_cu", "volume_ratio"]);
         assert_eq!(rows.len(), 100);

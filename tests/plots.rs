@@ -6,7 +6,8 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use pfem_mpi::plot::{
-    colour_map, plot_run, BLOCK_SIZE, COLOUR_BAR_WIDTH, CONTOUR_SIZE, CURVE_SIZE,
+    colour_map, plot_run, plot_run_in, Window, BLOCK_SIZE, COLOUR_BAR_WIDTH, CONTOUR_SIZE,
+    CURVE_SIZE,
 };
 
 /// A fresh, empty folder for one test.
@@ -135,8 +136,8 @@ fn series(step: u64, points: usize, triangles: usize) -> String {
 }
 
 /// Writes `DIR/fields.xdmf` and the frame file of `step` with the fields the solver writes,
-/// leaving out `omit`.
-fn write_frame(dir: &Path, step: u64, omit: &str, bad_vertex: bool) {
+/// leaving out `omit` and writing `zero` as zero everywhere.
+fn write_frame(dir: &Path, step: u64, omit: &str, bad_vertex: bool, zero: &str) {
     let (xy, mut tri) = grid(7);
     if bad_vertex {
         tri[3][1] = xy.len() as i64;
@@ -160,7 +161,10 @@ fn write_frame(dir: &Path, step: u64, omit: &str, bad_vertex: bool) {
     let group = file.create_group("point_data").unwrap();
     let scalar = |name: &str, f: &dyn Fn([f64; 2]) -> f64| {
         if name != omit {
-            let v: Vec<f64> = xy.iter().map(|&p| f(p)).collect();
+            let v: Vec<f64> = xy
+                .iter()
+                .map(|&p| if name == zero { 0.0 } else { f(p) })
+                .collect();
             let ds = group.new_dataset::<f64>().shape(n).create(name).unwrap();
             ds.write_raw(&v).unwrap();
         }
@@ -188,7 +192,7 @@ fn write_frame(dir: &Path, step: u64, omit: &str, bad_vertex: bool) {
 fn cantilever_history_and_contours() {
     let dir = folder("cantilever");
     fs::write(dir.join("history.csv"), CANTILEVER).unwrap();
-    write_frame(&dir, 7, "", false);
+    write_frame(&dir, 7, "", false, "");
     let written = plot_run(&dir).unwrap();
     let names: Vec<String> = written
         .iter()
@@ -341,14 +345,14 @@ fn bad_frames_are_errors_naming_the_file() {
     let dir = folder("bad-frame");
     fs::write(dir.join("history.csv"), CANTILEVER).unwrap();
 
-    write_frame(&dir, 3, "sigma_yy", false);
+    write_frame(&dir, 3, "sigma_yy", false, "");
     let e = plot_run(&dir).unwrap_err().to_string();
     assert!(
         e.contains("step_000003.h5") && e.contains("no dataset /point_data/sigma_yy"),
         "{e}"
     );
 
-    write_frame(&dir, 4, "", true);
+    write_frame(&dir, 4, "", true, "");
     let e = plot_run(&dir).unwrap_err().to_string();
     assert!(
         e.contains("step_000004.h5") && e.contains("/connectivity row 3"),
@@ -365,4 +369,126 @@ fn bad_frames_are_errors_naming_the_file() {
     fs::write(dir.join("fields.xdmf"), "not xml").unwrap();
     let e = plot_run(&dir).unwrap_err().to_string();
     assert!(e.contains("fields.xdmf: not an XDMF file"), "{e}");
+}
+
+/// The pixels of exactly `colour` left of the colour bar.
+fn count_exact(p: &Picture, colour: [u8; 3]) -> usize {
+    p.near(colour, 0, CONTOUR_SIZE.0 - COLOUR_BAR_WIDTH).len()
+}
+
+#[test]
+fn a_field_that_is_zero_everywhere_gets_no_picture() {
+    let dir = folder("zero-field");
+    fs::write(dir.join("history.csv"), CANTILEVER).unwrap();
+    write_frame(&dir, 7, "", false, "");
+    assert!(plot_run(&dir)
+        .unwrap()
+        .contains(&dir.join("plots/eps_q.png")));
+    // The elastic run's eps_q: no picture, and the older one is not left to mislead.
+    write_frame(&dir, 8, "", false, "eps_q");
+    let written = plot_run(&dir).unwrap();
+    assert!(
+        !written.contains(&dir.join("plots/eps_q.png")),
+        "{written:?}"
+    );
+    assert!(!dir.join("plots/eps_q.png").exists());
+    assert!(
+        written.contains(&dir.join("plots/tau_xy.png")),
+        "{written:?}"
+    );
+}
+
+/// A scene of the unit square under a rigid bar (a circle of radius 0.1 at (0.5, 1.1)) pushed
+/// 0.2 m down over 10 steps: at step 7 it is 0.14 m down, its lowest point at y = 0.86.
+const BAR_SCENE: &str = r#"
+name = "plot-bar"
+
+[body]
+rectangles = [{ origin = [0.0, 0.0], size = [1.0, 1.0] }]
+
+[mesh]
+h = 0.1
+
+[material]
+model = "tresca"
+young = 1.0e6
+poisson = 0.49
+cu = 1.0e3
+
+[[fixed]]
+where = "y <= 0"
+dofs = ["x", "y"]
+
+[[rigid]]
+name = "bar"
+circle = { centre = [0.5, 1.1], radius = 0.1 }
+stages = [{ to = [0.0, -0.2], steps = 10 }]
+
+[steps]
+count = 10
+
+[history]
+columns = [{ name = "depth", measure = "rigid.bar.uy", scale = -1.0 }]
+"#;
+
+#[test]
+fn rigid_bodies_are_drawn_where_their_stages_put_them() {
+    let dir = folder("rigid-outline");
+    fs::write(dir.join("history.csv"), "step,depth\n7,0.14\n").unwrap();
+    write_frame(&dir, 7, "", false, "");
+    plot_run(&dir).unwrap();
+    let without = Picture::read(&dir.join("plots/tau_xy.png"));
+    // A few pixels of the smoothed text may happen to have the fill's grey.
+    let base = count_exact(&without, [200, 200, 200]);
+    assert!(
+        base < 50,
+        "{base} pixels of the body's grey without a scene"
+    );
+    fs::write(dir.join("scene.toml"), BAR_SCENE).unwrap();
+    plot_run(&dir).unwrap();
+    let with = Picture::read(&dir.join("plots/tau_xy.png"));
+    let fill = with.near([200, 200, 200], 0, CONTOUR_SIZE.0 - COLOUR_BAR_WIDTH);
+    let line = count_exact(&with, [60, 60, 60]);
+    // The circle is 0.2 m across in a picture about 1.2 m across 600 pixels: about 100 pixels.
+    assert!(
+        fill.len() > 2000,
+        "{} pixels of the body's fill",
+        fill.len()
+    );
+    assert!(line > 150, "{line} pixels of its outline");
+    // It is at the top of the body, in the middle.
+    let (col, row) = (mean(&fill, |p| p.0), mean(&fill, |p| p.1));
+    let mid = f64::from(CONTOUR_SIZE.0 - COLOUR_BAR_WIDTH) / 2.0;
+    assert!(
+        (col - mid).abs() < 80.0,
+        "column {col} against the middle {mid}"
+    );
+    assert!(
+        row < f64::from(CONTOUR_SIZE.1) / 3.0,
+        "row {row}: not at the top"
+    );
+}
+
+#[test]
+fn a_window_frames_the_pictures_and_one_off_the_body_is_refused() {
+    let dir = folder("window");
+    fs::write(dir.join("history.csv"), CANTILEVER).unwrap();
+    write_frame(&dir, 7, "", false, "");
+    // eps_q = 0.2 x: a window along the bottom left, wider than the picture's aspect, shows
+    // x up to about 0.42 m of the 1.1, the lower half of the scale only.
+    let left = Window::parse("0,0,0.4,0.2").unwrap();
+    let written = plot_run_in(&dir, Some(left)).unwrap();
+    let p = Picture::read(&written[2]);
+    assert!(written[2].ends_with("eps_q.png"));
+    let mesh_right = CONTOUR_SIZE.0 - COLOUR_BAR_WIDTH;
+    assert!(p.near(colour_map(0.0), 30, mesh_right).len() > 50);
+    assert_eq!(
+        p.near(colour_map(1.0), 30, mesh_right).len(),
+        0,
+        "x = 1.1 is out of the window"
+    );
+    let e = plot_run_in(&dir, Some(Window::parse("5,5,6,6").unwrap()))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("--window 5,5,6,6 shows none of the body"), "{e}");
 }

@@ -35,7 +35,8 @@ fn close(a: &[f64], b: &[f64], tol: f64) {
 }
 
 #[test]
-fn footing_coarse_starts_near_prandtl_and_stays_below_the_deep_limit() {
+#[ignore = "coarse benchmark: rigid footing against Prandtl, 20 steps on 1 and 2 ranks"]
+fn footing_coarse_is_within_15_percent_of_prandtl_and_below_the_deep_limit() {
     let dir = workdir("footing-coarse");
     ok(
         &dir,
@@ -101,11 +102,13 @@ fn tbar(name: &str, exact: f64) {
 }
 
 #[test]
+#[ignore = "coarse benchmark: smooth T-bar against the exact Nc on 1 and 2 ranks"]
 fn tbar_smooth_coarse_is_within_8_percent_of_the_exact_nc() {
     tbar("tbar-smooth", 9.142);
 }
 
 #[test]
+#[ignore = "coarse benchmark: rough T-bar against the exact Nc on 1 and 2 ranks"]
 fn tbar_rough_coarse_is_within_8_percent_of_the_exact_nc() {
     tbar("tbar-rough", 11.940);
 }
@@ -132,7 +135,8 @@ fn new_pipeline(dir: &Path) {
 }
 
 #[test]
-fn pipeline_coarse_vertical_then_lateral() {
+#[ignore = "coarse benchmark: pipeline pushed down then sideways on 1 and 2 ranks"]
+fn pipeline_coarse_v_is_within_the_dnv_range_widened_25_percent_then_sideways_h_exceeds_1() {
     let dir = workdir("pipeline-coarse");
     new_pipeline(&dir);
     let [r1, r2] = both(&dir, "p.h5");
@@ -167,6 +171,7 @@ fn pipeline_coarse_vertical_then_lateral() {
 }
 
 #[test]
+#[ignore = "coarse benchmark: a staged pipeline run and its restart on another rank count"]
 fn staged_run_restarts_in_its_second_stage_on_another_rank_count() {
     let dir = workdir("pipeline-restart");
     new_pipeline(&dir);

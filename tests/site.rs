@@ -127,7 +127,7 @@ fn a_strength_that_turns_negative_is_refused() {
 /// The coarse vertical cut (h = H/10) collapses within 5 % of Ns = 3.78 on 1 and 2 ranks, and
 /// says so with exit 0.
 #[test]
-fn a_coarse_vertical_cut_collapses_near_the_exact_stability_number() {
+fn a_coarse_vertical_cut_collapses_within_5_percent_of_the_stability_number() {
     let dir = workdir("vertical-cut");
     ok(
         &dir,

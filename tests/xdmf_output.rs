@@ -1,12 +1,12 @@
 //! Runs the ParaView output self test (`examples/xdmf_selftest.rs`) under `mpirun` on 1, 2 and
 //! 3 ranks, then checks each output folder with an independent reader, `tests/check_xdmf.py`
-//! (Python: xml.etree + h5py, and meshio when it is installed). MPI can be initialised only once
+//! (Python: xml.etree + h5py, and meshio when it is installed; `.ci/install-native` installs both). MPI can be initialised only once
 //! per process, so the writing happens in the example binary.
 
 mod common;
-use common::{example_binary, mpirun_example, run_captured as run};
+use common::{example_binary, mpirun_example, prerequisite, python_has, run_captured as run};
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::Command;
 
 const EXAMPLE: &str = "xdmf_selftest";
 
@@ -21,57 +21,13 @@ fn check_with_python(dir: &Path) -> Result<String, String> {
     run(cmd, "python3 tests/check_xdmf.py")
 }
 
-fn python_has(module: &str) -> bool {
-    Command::new("python3")
-        .args(["-c", &format!("import {module}")])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
-}
-
-fn pip_install(packages: &[&str]) -> String {
-    let out = Command::new("python3")
-        .args(["-m", "pip", "install", "--quiet"])
-        .args(packages)
-        .output();
-    match out {
-        Ok(o) if o.status.success() => String::new(),
-        Ok(o) => format!(
-            "`python3 -m pip install --quiet {}` failed ({}): {}",
-            packages.join(" "),
-            o.status,
-            String::from_utf8_lossy(&o.stderr).trim()
-        ),
-        Err(e) => format!("cannot run python3: {e}"),
-    }
-}
-
-/// Makes sure the checker can run: h5py is required, meshio is used when it installs.
-fn python_ready() -> Result<(), String> {
-    if python_has("h5py") && python_has("meshio") {
-        return Ok(());
-    }
-    let mut report = pip_install(&["h5py", "meshio"]);
-    if !python_has("h5py") {
-        // meshio may be what failed; h5py alone is enough for the required checks.
-        report.push('\n');
-        report.push_str(&pip_install(&["h5py"]));
-    }
-    if python_has("h5py") {
-        Ok(())
-    } else {
-        Err(format!(
-            "the independent XDMF check needs python3 with h5py (and numpy), which could not \
-             be installed:\n{report}"
-        ))
-    }
-}
-
 #[test]
 fn xdmf_output_on_1_2_3_ranks_reads_back_independently() {
     let binary = example_binary(EXAMPLE).unwrap_or_else(|e| panic!("{e}"));
-    python_ready().unwrap_or_else(|e| panic!("{e}"));
+    // meshio is optional to the checker; h5py (with numpy) is not.
+    if !prerequisite("Python's h5py (python3-h5py)", python_has("h5py")) {
+        return;
+    }
     let root =
         Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("xdmf-output-{}", std::process::id()));
     let mut failures = Vec::new();

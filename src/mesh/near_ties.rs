@@ -408,7 +408,7 @@ mod tests {
 
     /// Timing, not a check: `cargo test --release --lib meshing_timing -- --ignored --nocapture`.
     #[test]
-    #[ignore]
+    #[ignore = "timing study of Delaunay on 100 000 points, run with the coarse benchmarks"]
     fn meshing_timing() {
         let mut state = 5u64;
         let mut unit = || (crate::rng::next(&mut state) >> 11) as f64 / (1u64 << 53) as f64;

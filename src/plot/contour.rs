@@ -1,19 +1,22 @@
 //! Contour pictures of a per-particle field on the deformed mesh of a frame, like the seed
 //! paper's Figs 12, 17 and 20: every triangle filled with the field interpolated linearly
 //! between its vertices (each pixel centre coloured from its barycentric coordinates), the
-//! body's outline, the mesh when its triangles are large enough to see, axes in metres at equal
-//! scale, and a colour bar with the field's minimum and maximum.
+//! body's outline, the mesh when its triangles are large enough to see, the rigid bodies (grey,
+//! outlined), axes in metres at equal scale over the window (`super::window`), and a colour bar
+//! with the field's minimum and maximum: viridis, or blue–white–red about zero for a field of
+//! both signs.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::colour_map::colour_map;
+use super::colour_map::{colour_map, diverging_colour_map};
 use super::font::FAMILY;
 use super::frame::Frame;
 use super::numbers::short;
 use super::picture::{save, Area, Drawn};
+use super::window::{clip_polygon, clip_segment, Window};
 use super::PlotError;
 
 /// Width and height in pixels of a contour picture.
@@ -73,11 +76,10 @@ fn finite_range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     })
 }
 
-/// Axis ranges of a plot `width` x `height` pixels showing `frame` at equal scale in x and y.
-fn equal_scale_ranges(frame: &Frame, width: f64, height: f64) -> ((f64, f64), (f64, f64)) {
-    let used = || frame.triangles.iter().flatten().map(|&i| frame.position[i]);
-    let x = finite_range(used().map(|p| p[0])).unwrap_or((0.0, 1.0));
-    let y = finite_range(used().map(|p| p[1])).unwrap_or((0.0, 1.0));
+/// Axis ranges of a plot `width` x `height` pixels showing `window` (with 3 % to spare) at
+/// equal scale in x and y, centred.
+fn equal_scale_ranges(window: &Window, width: f64, height: f64) -> ((f64, f64), (f64, f64)) {
+    let (x, y) = ((window.x0, window.x1), (window.y0, window.y1));
     let size = (x.1 - x.0).max(y.1 - y.0);
     let size = if size > 0.0 { size } else { 1.0 };
     let pad = 0.03 * size;
@@ -89,6 +91,59 @@ fn equal_scale_ranges(frame: &Frame, width: f64, height: f64) -> ((f64, f64), (f
     };
     (centred(x, width), centred(y, height))
 }
+
+/// How the values map to colours: viridis over [lo, hi], or for a field of both signs the
+/// diverging scale over [-m, m], m the larger magnitude, so that white is zero.
+#[derive(Debug, Clone, Copy)]
+struct Scale {
+    lo: f64,
+    hi: f64,
+    diverging: bool,
+}
+
+impl Scale {
+    fn of(lo: f64, hi: f64) -> Scale {
+        if lo < 0.0 && hi > 0.0 {
+            let m = hi.max(-lo);
+            Scale {
+                lo: -m,
+                hi: m,
+                diverging: true,
+            }
+        } else {
+            Scale {
+                lo,
+                hi,
+                diverging: false,
+            }
+        }
+    }
+
+    fn colour(&self, v: f64) -> RGBColor {
+        let t = if self.hi > self.lo {
+            (v - self.lo) / (self.hi - self.lo)
+        } else {
+            0.5
+        };
+        let [r, g, b] = if self.diverging {
+            diverging_colour_map(t)
+        } else {
+            colour_map(t)
+        };
+        RGBColor(r, g, b)
+    }
+}
+
+/// What a contour picture shows besides the field: the part of the plane, and the rigid
+/// bodies' outlines there.
+pub(crate) struct View<'a> {
+    pub window: Window,
+    pub bodies: &'a [Vec<[f64; 2]>],
+}
+
+/// Fill and outline of the rigid bodies.
+const BODY_FILL: RGBColor = RGBColor(200, 200, 200);
+pub(crate) const BODY_LINE: RGBColor = RGBColor(60, 60, 60);
 
 /// Maps metres to continuous pixel coordinates the way plotters places points: pixel `i`
 /// holds the points that map into [i, i + 1).
@@ -186,15 +241,12 @@ fn edges(triangles: &[[usize; 3]]) -> BTreeMap<(usize, usize), u32> {
     count
 }
 
-fn rgb(t: f64) -> RGBColor {
-    let [r, g, b] = colour_map(t);
-    RGBColor(r, g, b)
-}
-
-/// Draws `values` (one per particle of `frame`) as a contour picture titled `title` to `path`.
+/// Draws `values` (one per particle of `frame`) as a contour picture of `view` titled `title`
+/// to `path`.
 pub(crate) fn draw(
     frame: &Frame,
     values: &[f64],
+    view: &View,
     title: &str,
     path: &Path,
 ) -> Result<(), PlotError> {
@@ -209,11 +261,17 @@ pub(crate) fn draw(
         ));
     }
     save(path, CONTOUR_SIZE, |root: &Area<'_>| {
-        draw_on(root, frame, values, title)
+        draw_on(root, frame, values, view, title)
     })
 }
 
-fn draw_on<'a>(root: &Area<'a>, frame: &Frame, values: &[f64], title: &str) -> Drawn<'a> {
+fn draw_on<'a>(
+    root: &Area<'a>,
+    frame: &Frame,
+    values: &[f64],
+    view: &View,
+    title: &str,
+) -> Drawn<'a> {
     let body = root.titled(title, (FAMILY, 26))?;
     let (mesh_area, bar_area) = body.split_horizontally(CONTOUR_SIZE.0 - COLOUR_BAR_WIDTH);
 
@@ -221,7 +279,15 @@ fn draw_on<'a>(root: &Area<'a>, frame: &Frame, values: &[f64], title: &str) -> D
     let (w, h) = mesh_area.dim_in_pixel();
     let plot_w = f64::from(w.saturating_sub(2 * MARGIN + Y_LABELS).max(2) - 1);
     let plot_h = f64::from(h.saturating_sub(2 * MARGIN + X_LABELS).max(2) - 1);
-    let (xr, yr) = equal_scale_ranges(frame, plot_w, plot_h);
+    let (xr, yr) = equal_scale_ranges(&view.window, plot_w, plot_h);
+    // Everything is clipped to the plotting area, which the equal scale may make wider or
+    // taller than the window.
+    let shown = Window {
+        x0: xr.0,
+        y0: yr.0,
+        x1: xr.1,
+        y1: yr.1,
+    };
     let mut chart = ChartBuilder::on(&mesh_area)
         .margin(MARGIN)
         .x_label_area_size(X_LABELS)
@@ -237,7 +303,7 @@ fn draw_on<'a>(root: &Area<'a>, frame: &Frame, values: &[f64], title: &str) -> D
         .draw()?;
 
     let (lo, hi) = finite_range(values.iter().copied()).unwrap_or((0.0, 1.0));
-    let scale = |v: f64| if hi > lo { (v - lo) / (hi - lo) } else { 0.5 };
+    let scale = Scale::of(lo, hi);
     let (cols, rows) = chart.plotting_area().get_pixel_range();
     let to_px = ToPixels::new(xr, yr, cols.clone(), rows.clone());
     let mut failed = Ok(());
@@ -248,40 +314,63 @@ fn draw_on<'a>(root: &Area<'a>, frame: &Frame, values: &[f64], title: &str) -> D
         }
         fill_triangle(p, t.map(|i| values[i]), (&cols, &rows), |c, r, v| {
             if failed.is_ok() {
-                failed = root.draw_pixel((c, r), &rgb(scale(v)));
+                failed = root.draw_pixel((c, r), &scale.colour(v));
             }
         });
         std::mem::replace(&mut failed, Ok(()))?;
     }
 
     let edges = edges(&frame.triangles);
-    let at = |i: usize| (frame.position[i][0], frame.position[i][1]);
+    let clipped = |&(a, b): &(usize, usize)| {
+        let (p, q) = clip_segment(frame.position[a], frame.position[b], &shown)?;
+        Some(((p[0], p[1]), (q[0], q[1])))
+    };
     let on_screen = |&(a, b): &(usize, usize)| {
         let (pa, pb) = (to_px.map(frame.position[a]), to_px.map(frame.position[b]));
         (pa[0] - pb[0]).hypot(pa[1] - pb[1])
     };
-    let mean_px = edges
+    let visible: Vec<f64> = edges
         .keys()
+        .filter(|e| clipped(e).is_some())
         .map(on_screen)
         .filter(|l| l.is_finite())
-        .sum::<f64>()
-        / edges.len().max(1) as f64;
+        .collect();
+    let mean_px = visible.iter().sum::<f64>() / visible.len().max(1) as f64;
     if mean_px >= MESH_LINES_FROM_PX {
         chart.draw_series(
             edges
                 .iter()
                 .filter(|(_, &n)| n > 1)
-                .map(|(&(a, b), _)| PathElement::new(vec![at(a), at(b)], BLACK.mix(0.3))),
+                .filter_map(|(e, _)| clipped(e))
+                .map(|(p, q)| PathElement::new(vec![p, q], BLACK.mix(0.3))),
         )?;
     }
     chart.draw_series(
         edges
             .iter()
             .filter(|(_, &n)| n == 1)
-            .map(|(&(a, b), _)| PathElement::new(vec![at(a), at(b)], BLACK.stroke_width(1))),
+            .filter_map(|(e, _)| clipped(e))
+            .map(|(p, q)| PathElement::new(vec![p, q], BLACK.stroke_width(1))),
     )?;
+    for body in view.bodies {
+        let inside: Vec<(f64, f64)> = clip_polygon(body, &shown)
+            .iter()
+            .map(|p| (p[0], p[1]))
+            .collect();
+        if inside.len() >= 3 {
+            chart.draw_series(std::iter::once(Polygon::new(inside, BODY_FILL.filled())))?;
+        }
+        chart.draw_series(
+            body.iter()
+                .zip(body.iter().cycle().skip(1))
+                .filter_map(|(&p, &q)| clip_segment(p, q, &shown))
+                .map(|(p, q)| {
+                    PathElement::new(vec![(p[0], p[1]), (q[0], q[1])], BODY_LINE.stroke_width(2))
+                }),
+        )?;
+    }
 
-    draw_colour_bar(&bar_area, lo, hi)
+    draw_colour_bar(&bar_area, lo, hi, scale)
 }
 
 /// The colour bar: the colour scale from `lo` (bottom) to `hi` (top) with ticks, and the two
@@ -290,12 +379,13 @@ fn draw_colour_bar<'a>(
     area: &DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>,
     lo: f64,
     hi: f64,
+    scale: Scale,
 ) -> Drawn<'a> {
     const TOP: u32 = 50;
     const BOTTOM: u32 = MARGIN + X_LABELS + 10;
     // A constant field still needs an axis of some length.
-    let (a0, a1) = if hi > lo {
-        (lo, hi)
+    let (a0, a1) = if scale.hi > scale.lo {
+        (scale.lo, scale.hi)
     } else {
         let d = (lo.abs() * 0.1).max(1e-12);
         (lo - d, hi + d)
@@ -318,12 +408,10 @@ fn draw_colour_bar<'a>(
     let step = (a1 - a0) / BAR_STEPS as f64;
     bar.draw_series((0..BAR_STEPS).map(|k| {
         let v0 = a0 + step * k as f64;
-        let t = if hi > lo {
-            (k as f64 + 0.5) / BAR_STEPS as f64
-        } else {
-            0.5
-        };
-        Rectangle::new([(0.0, v0), (1.0, v0 + step)], rgb(t).filled())
+        Rectangle::new(
+            [(0.0, v0), (1.0, v0 + step)],
+            scale.colour(v0 + 0.5 * step).filled(),
+        )
     }))?;
     bar.draw_series(std::iter::once(Rectangle::new(
         [(0.0, a0), (1.0, a1)],

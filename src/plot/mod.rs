@@ -17,11 +17,15 @@
 //!   declares for that column (dashed, labelled in the legend; none without `scene.toml`),
 //!   axes named by the columns. The picture is [`declared_size`] for its number of panels.
 //! - `FIELD.png` for `FIELD` = `eps_q`, `sigma_yy`, `tau_xy` (and `incremental_displacement`,
-//!   as its length, when the frame has it), when `DIR/fields.xdmf` lists a frame: the field on
-//!   the deformed mesh of the last frame, interpolated linearly in each triangle, axes in metres
-//!   at equal scale, a colour bar ([`colour_map()`], blue = minimum, red = maximum) with the
-//!   minimum and maximum written out, titled with the field and the step. The picture is
-//!   [`CONTOUR_SIZE`], the colour bar its rightmost [`COLOUR_BAR_WIDTH`] pixels.
+//!   as its length, when the frame has it), when `DIR/fields.xdmf` lists a frame and the field
+//!   is not zero everywhere (an elastic run has no `eps_q.png`): the field on the deformed mesh
+//!   of the last frame, interpolated linearly in each triangle, with the rigid bodies of
+//!   `scene.toml` where their stages put them at the frame's step, axes in metres at equal
+//!   scale over the region where the field varies ([`window::focus`]) or the window asked for,
+//!   a colour bar ([`colour_map()`], viridis; [`diverging_colour_map()`] about zero for a field
+//!   of both signs) with the minimum and maximum written out, titled with the field and the
+//!   step. The picture is [`CONTOUR_SIZE`], the colour bar its rightmost [`COLOUR_BAR_WIDTH`]
+//!   pixels.
 //!
 //! Text is drawn with a font compiled into the binary, so plotting needs no system fonts.
 
@@ -38,20 +42,30 @@ mod numbers;
 mod panel;
 mod picture;
 mod reference;
+mod rigid_outline;
 mod scene_file;
+pub mod window;
 
 use std::path::{Path, PathBuf};
 
-pub use colour_map::colour_map;
+pub use colour_map::{colour_map, diverging_colour_map};
 pub use contour::{COLOUR_BAR_WIDTH, CONTOUR_SIZE};
 pub use declared::{declared_size, PANEL_HEIGHT};
 pub use error::PlotError;
 pub use legacy::{BLOCK_SIZE, CURVE_SIZE};
+pub use window::Window;
 
 /// Writes `DIR/plots/*.png`: the history's curve(s) with reference lines (a legacy kind's, or
 /// the scene's declared columns' from `DIR/scene.toml`), and contour pictures of eps_q,
 /// sigma_yy, tau_xy on the deformed mesh of the last frame (if `DIR/fields.xdmf` exists and
-/// lists a frame); see the module documentation. Returns the files written, history first.
+/// lists a frame), each framed on where it varies; see the module documentation. Returns the
+/// files written, history first.
+pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    plot_run_in(dir, None)
+}
+
+/// [`plot_run`], the contour pictures showing `window` when given (`pfem-mpi plot DIR --window
+/// x0,y0,x1,y1`); a window that shows none of the body is an error naming `--window`.
 ///
 /// All inputs are read before any picture is written. Errors name the file at fault: a missing
 /// or malformed `history.csv`, a damaged `fields.xdmf`, a frame file that cannot be read or
@@ -59,7 +73,7 @@ pub use legacy::{BLOCK_SIZE, CURVE_SIZE};
 /// parsed is no error: a warning on stderr, and the history is drawn as without one. Values
 /// that are not finite or beyond `history::DRAWABLE` are left out of the curves, the latter
 /// with a warning on stderr.
-pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+pub fn plot_run_in(dir: &Path, window: Option<Window>) -> Result<Vec<PathBuf>, PlotError> {
     font::register()?;
     let history_file = dir.join("history.csv");
     let history = history::read(&history_file)?;
@@ -89,6 +103,14 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
         }
     }
 
+    let bodies = match (&scene, &frame) {
+        (Some(scene), Some(frame)) => rigid_outline::outlines(scene, frame.step),
+        _ => Vec::new(),
+    };
+    if let (Some(w), Some(frame)) = (window, &frame) {
+        check_window(&w, frame)?;
+    }
+
     let out = dir.join("plots");
     std::fs::create_dir_all(&out)
         .map_err(|e| PlotError::new(&out, format!("cannot create folder: {e}")))?;
@@ -101,11 +123,60 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
             Some(t) => format!("step {}, t = {}", frame.step, numbers::short(t)),
             None => format!("step {}", frame.step),
         };
+        let boxes: Vec<Window> = bodies
+            .iter()
+            .filter_map(|b| Window::around(b.iter().copied()))
+            .collect();
         for (spec, values) in &fields {
             let path = out.join(format!("{}.png", spec.field));
-            contour::draw(frame, values, &format!("{} — {when}", spec.label), &path)?;
+            // A field that is zero everywhere (the plastic strain of an elastic run) says
+            // nothing a picture would show; an older picture of it is not this run's.
+            if values.iter().all(|&v| v == 0.0) {
+                let _ = std::fs::remove_file(&path);
+                continue;
+            }
+            let focus = || window::focus(&frame.position, &frame.triangles, values, &boxes);
+            let Some(window) = window.or_else(focus) else {
+                continue;
+            };
+            let view = contour::View {
+                window,
+                bodies: &bodies,
+            };
+            contour::draw(
+                frame,
+                values,
+                &view,
+                &format!("{} — {when}", spec.label),
+                &path,
+            )?;
             written.push(path);
         }
     }
     Ok(written)
+}
+
+/// A `--window` must show some of the body.
+fn check_window(w: &Window, frame: &frame::Frame) -> Result<(), PlotError> {
+    let used = frame.triangles.iter().flatten().map(|&i| frame.position[i]);
+    let Some(body) = Window::around(used) else {
+        return Ok(());
+    };
+    if body.intersect(*w).is_some() {
+        return Ok(());
+    }
+    Err(PlotError::new(
+        &frame.path,
+        format!(
+            "--window {},{},{},{} shows none of the body, which spans x {} .. {}, y {} .. {}",
+            w.x0,
+            w.y0,
+            w.x1,
+            w.y1,
+            numbers::short(body.x0),
+            numbers::short(body.x1),
+            numbers::short(body.y0),
+            numbers::short(body.y1)
+        ),
+    ))
 }

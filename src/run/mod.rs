@@ -8,14 +8,17 @@ mod geostatic;
 mod node_values;
 mod output;
 mod progress;
+mod progress_json;
 mod rank_table;
 mod refinement;
 mod restart;
+mod run_log;
 mod sanity;
 mod signals;
 mod simulation;
 mod step;
 mod step_solver;
+mod terminal;
 mod test_hooks;
 
 pub use error::{RunError, EXIT_FAILURE, EXIT_USAGE};
@@ -34,6 +37,10 @@ pub struct RunOptions {
     pub case: PathBuf,
     pub out_dir: PathBuf,
     pub until_step: Option<u64>,
+    /// What stdout shows while the run steps (`--progress`).
+    pub progress: crate::cli::ProgressMode,
+    /// Every step's full line on the terminal too (`--verbose`).
+    pub verbose: bool,
 }
 
 /// How long a rank with an error waits for the others before it takes them to be stuck in a
@@ -62,10 +69,23 @@ pub fn agree_or_abort(errors: &Comm, local: Result<(), RunError>) -> Result<(), 
 pub fn run(world: &Comm, petsc: &Petsc, opts: &RunOptions) -> Result<(), RunError> {
     let errors = world.duplicate();
     let mut held = None;
-    let outcome = drive(world, petsc, opts, &mut held);
+    let mut progress = None;
+    let outcome = drive(world, petsc, opts, &mut held, &mut progress);
+    // Rank 0 logs its own error before the agreement, which may abort the job when the other
+    // ranks wait elsewhere; another rank's error once it is agreed.
+    let logged = match (&outcome, progress.as_mut()) {
+        (Err(e), Some(progress)) => {
+            progress.failed(e);
+            true
+        }
+        _ => false,
+    };
     // Agreed before the simulation is dropped: destroying its solver is collective, and a rank
     // that failed alone would wait there for ever.
     let agreed = agree_or_abort(&errors, outcome);
+    if let (Err(e), Some(progress), false) = (&agreed, progress.as_mut(), logged) {
+        progress.failed(e);
+    }
     drop(held);
     agreed
 }
@@ -75,6 +95,7 @@ fn drive(
     petsc: &Petsc,
     opts: &RunOptions,
     held: &mut Option<Simulation>,
+    progress: &mut Option<Progress>,
 ) -> Result<(), RunError> {
     let stop = signals::StopRequest::install()?;
     let rank = world.rank();
@@ -83,13 +104,11 @@ fn drive(
     let sim = held.insert(Simulation::load(world, &opts.case)?);
     sanity::check_until_step(opts, sim)?;
     let mut out = output::Output::open(world, sim, &opts.out_dir)?;
-    if world.rank() == 0 {
-        println!(
-            "step solver: {}",
-            step_solver::StepSolver::of(&sim.model, step::MAX_CUTS)
-        );
-    }
-    let mut progress = Progress::new(world, sim.total_steps());
+    let progress = progress.insert(Progress::new(world, sim, opts)?);
+    progress.note(&format!(
+        "step solver: {}",
+        step_solver::StepSolver::of(&sim.model, step::MAX_CUTS)
+    ));
     let mut last = opts.until_step.unwrap_or(u64::MAX).min(sim.total_steps());
     // The per-rank table after the end-of-run line: sizes of the last mesh, CPU of the solves.
     let mut sizes = None;
@@ -98,12 +117,10 @@ fn drive(
     let equilibrate = sim.model.scene.geostatic.is_some_and(|g| g.equilibrate);
     if sim.step() == 0 && equilibrate {
         let (newton, left) = sim.equilibrate_geostatic(world, petsc)?;
-        if rank == 0 {
-            println!(
-                "geostatic: equilibrated in {newton} Newton iterations (last pass moved \
-                 {left:.1e} of the first)"
-            );
-        }
+        progress.note(&format!(
+            "geostatic: equilibrated in {newton} Newton iterations (last pass moved {left:.1e} \
+             of the first)"
+        ));
     }
     while sim.step() < last {
         let mut t = PhaseTimer::default();
@@ -127,10 +144,11 @@ fn drive(
             last = sim.step();
             collapse = collapse.or(report.collapse);
         }
+        let mut row = None;
         t.time("output", || {
             fault("output", next)?;
             if advanced {
-                out.record(world, sim)?;
+                row = out.record(world, sim)?;
             }
             out.fields_if_due(world, sim, &mesh, last)
         })?;
@@ -142,7 +160,9 @@ fn drive(
             fault("balance", next)?;
             sim.rebalance_if_needed(world)
         })?;
-        progress.step(sim, &report, &t);
+        let columns = crate::history::header(sim.scene());
+        let history = row.as_deref().map(|r| (&columns[1..], r));
+        progress.step(sim, &report, &t, history);
         // Measured once, on the last mesh: the same condition on every rank (`last` is agreed).
         if sim.step() >= last {
             let tri_material = sim.triangle_materials(&mesh);
@@ -155,8 +175,13 @@ fn drive(
     }
     progress.finish(sim);
     if let Some(sizes) = &sizes {
-        rank_table::print(world, sizes, solve_cpu);
+        for line in rank_table::lines(world, sizes, solve_cpu) {
+            progress.note(&line);
+        }
     }
     out.plot(world)?;
-    sanity::check_collapse(world, sim, collapse, opts.until_step)
+    if let Some(line) = sanity::check_collapse(sim, collapse, opts.until_step)? {
+        progress.note(&line);
+    }
+    Ok(())
 }

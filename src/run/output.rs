@@ -127,16 +127,19 @@ impl Output {
         agree(world, local)
     }
 
-    /// Collective. Appends the step's row.
-    pub fn record(&mut self, world: &Comm, sim: &Simulation) -> Result<(), RunError> {
+    /// Collective. Appends the step's row, and returns it (after `step`) on rank 0.
+    pub fn record(&mut self, world: &Comm, sim: &Simulation) -> Result<Option<Vec<f64>>, RunError> {
         let m = sim.measures(world);
         let mut local = None;
+        let mut row = None;
         if let Some(h) = self.history.as_mut() {
-            if let Err(e) = history::row(sim.scene(), &m).and_then(|r| h.append(sim.step(), &r)) {
-                local = Some(RunError::History(e));
+            match history::row(sim.scene(), &m).and_then(|r| h.append(sim.step(), &r).map(|_| r)) {
+                Ok(r) => row = Some(r),
+                Err(e) => local = Some(RunError::History(e)),
             }
         }
-        agree(world, local)
+        agree(world, local)?;
+        Ok(row)
     }
 
     /// Collective. Checkpoint every K steps (scene setting) and at the last step of the run.

@@ -78,7 +78,7 @@ const COLUMNS: usize = 9;
 /// and of the whole process, and its peak RSS on rank 0, which prints one line per rank under a
 /// header. No word of it is one the progress lines' parsers look for ("particles ", "Newton",
 /// "cpu_s", ...): tests and bench scripts grep the whole output.
-pub fn print(world: &Comm, sizes: &RankSizes, solve_cpu: f64) {
+pub fn lines(world: &Comm, sizes: &RankSizes, solve_cpu: f64) -> Vec<String> {
     // Milliseconds, so that one u64 gather carries every column.
     let ms = |s: f64| (s * 1000.0).round().max(0.0) as u64;
     let local: [u64; COLUMNS] = [
@@ -94,12 +94,12 @@ pub fn print(world: &Comm, sizes: &RankSizes, solve_cpu: f64) {
     ];
     let all = gather_to_root(world, &local);
     if world.rank() != 0 {
-        return;
+        return Vec::new();
     }
-    println!(
-        "per-rank sizes of the last solved mesh (CPU in seconds: solve phases, whole process; peak RSS from VmHWM):"
-    );
-    println!(
+    let mut lines = vec![
+        "per-rank sizes of the last solved mesh (CPU in seconds: solve phases, whole process; peak RSS from VmHWM):".to_string(),
+    ];
+    lines.push(format!(
         "{:>5} {:>10} {:>9} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>11}",
         "rank",
         "owned",
@@ -111,9 +111,10 @@ pub fn print(world: &Comm, sizes: &RankSizes, solve_cpu: f64) {
         "solve_cpu",
         "cpu_total",
         "peak_rss_MB"
-    );
+    ));
+
     for (rank, row) in all.chunks_exact(COLUMNS).enumerate() {
-        println!(
+        lines.push(format!(
             "{rank:>5} {:>10} {:>9} {:>10} {:>10} {:>10} {:>10} {:>9.2} {:>9.2} {:>11.1}",
             row[0],
             row[1],
@@ -124,6 +125,7 @@ pub fn print(world: &Comm, sizes: &RankSizes, solve_cpu: f64) {
             row[6] as f64 / 1000.0,
             row[7] as f64 / 1000.0,
             row[8] as f64 / 1024.0
-        );
+        ));
     }
+    lines
 }

@@ -6,7 +6,6 @@
 use super::{RunError, RunOptions, Simulation, StepReport};
 use crate::mesh::LocalMesh;
 use crate::scene::Scene;
-use mpi::traits::Communicator;
 use pfem_partition::{sum_f64, Comm};
 
 /// Smallest body area, as a fraction of the scene's, that a step may end with. Plastic flow
@@ -83,29 +82,23 @@ fn holds_in_a_triangle(mesh: &LocalMesh, gid: u64) -> bool {
 /// Collective. After a step solved on `mesh`: an error when the mesh had no triangle, when the
 /// body's area fell below [`MIN_AREA_RATIO`] of the scene's, or when a `[[point_load]]`'s
 /// particle was in no triangle (the load was not applied). The same verdict on every rank.
-/// Collective. Under `steps.until_collapse`, says where the collapse was bracketed; reaching
-/// the last step without one is an error (the load never got there).
+/// Under `steps.until_collapse`, the line saying where the collapse was bracketed; reaching
+/// the last step without one is an error (the load never got there). The same on every rank.
 pub(super) fn check_collapse(
-    world: &Comm,
     sim: &Simulation,
     collapse: Option<[f64; 2]>,
     until_step: Option<u64>,
-) -> Result<(), RunError> {
+) -> Result<Option<String>, RunError> {
     let steps = sim.scene().steps;
     if !steps.until_collapse {
-        return Ok(());
+        return Ok(None);
     }
     match collapse {
-        Some([held, failed]) => {
-            if world.rank() == 0 {
-                println!(
-                    "collapse reached: equilibrium holds at load factor {held:.6} and fails by \
-                     {failed:.6} (steps.collapse_tolerance = {})",
-                    steps.collapse_tolerance
-                );
-            }
-            Ok(())
-        }
+        Some([held, failed]) => Ok(Some(format!(
+            "collapse reached: equilibrium holds at load factor {held:.6} and fails by \
+             {failed:.6} (steps.collapse_tolerance = {})",
+            steps.collapse_tolerance
+        ))),
         None if sim.step() >= sim.total_steps() && until_step.is_none_or(|u| u >= sim.step()) => {
             Err(RunError::Sanity {
                 step: sim.step(),
@@ -117,7 +110,7 @@ pub(super) fn check_collapse(
                 ),
             })
         }
-        None => Ok(()),
+        None => Ok(None),
     }
 }
 

@@ -149,6 +149,11 @@ impl Simulation {
         self.header.load_factor
     }
 
+    /// The pseudo-time of the quasi-static analysis at the end of the last step.
+    pub fn time(&self) -> f64 {
+        self.header.time
+    }
+
     pub fn scene(&self) -> &Scene {
         &self.model.scene
     }

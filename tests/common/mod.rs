@@ -3,9 +3,15 @@
 #![allow(dead_code)]
 
 mod launch;
+mod prereq;
+mod progress;
 mod rng;
 #[allow(unused_imports)]
 pub use launch::{example_binary, mpirun_example, run_captured};
+#[allow(unused_imports)]
+pub use prereq::{in_ci, prerequisite, python_has, tool_runs};
+#[allow(unused_imports)]
+pub use progress::{json_objects, json_steps};
 #[allow(unused_imports)]
 pub use rng::Rng;
 
