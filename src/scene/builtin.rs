@@ -34,6 +34,7 @@ pub const BUILTINS: &[(&str, &str)] = &[
         include_str!("builtin/circular-footing.toml"),
     ),
     ("ball", include_str!("builtin/ball.toml")),
+    ("spudcan", include_str!("builtin/spudcan.toml")),
     (
         "footing-mohr-coulomb",
         include_str!("builtin/footing-mohr-coulomb.toml"),
