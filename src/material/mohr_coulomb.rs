@@ -31,8 +31,8 @@
 //! it) and `eps_q` = Σ √(2/3 Δε^p:Δε^p).
 
 use super::elastic::LinearElastic;
-use super::layout::{equivalent_plastic_strain, grew, internal_len};
-use super::principal::{product, solve_small, Spectral};
+use super::layout::{grew, internal_len};
+use super::principal::{solve_small, Spectral};
 use super::{GaussState, InternalVar, Material, MaterialError, MaterialResponse};
 
 /// The internal variables: as Tresca's, so that a scene of clay and sand shares the columns.
@@ -339,19 +339,8 @@ impl Material for MohrCoulomb {
             });
         }
         let relief: [f64; 3] = std::array::from_fn(|i| frame.values[i] - values[i]);
-        let dep = frame.compose_strain(&mat_vec(&self.principal_compliance(), &relief));
-        for (p, d) in state.internal[PLASTIC_STRAIN..PLASTIC_STRAIN + 4]
-            .iter_mut()
-            .zip(dep)
-        {
-            *p += d;
-        }
-        state.internal[EPS_Q] += equivalent_plastic_strain(&dep);
-        Ok(MaterialResponse {
-            s: frame.compose(&values),
-            d: product(&frame.isotropic_tangent(&values, &dv), &trial.d),
-            state,
-        })
+        let plastic = mat_vec(&self.principal_compliance(), &relief);
+        Ok(frame.returned(&values, &dv, &plastic, &trial.d, state))
     }
 
     fn name(&self) -> &'static str {

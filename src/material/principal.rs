@@ -86,6 +86,33 @@ impl Spectral {
         out
     }
 
+    /// The response of a return in this (trial) frame: principal stresses `values` with
+    /// derivatives `dv` by the trial's, the plastic strain `plastic` (principal values) added to
+    /// `state`'s plastic strain and `eps_q` (Mohr–Coulomb's layout, which Tresca shares), the tangent the isotropic one times the elastic `trial_d`.
+    pub fn returned(
+        &self,
+        values: &[f64; 3],
+        dv: &[[f64; 3]; 3],
+        plastic: &[f64; 3],
+        trial_d: &[[f64; 4]; 4],
+        mut state: super::GaussState,
+    ) -> super::MaterialResponse {
+        use super::mohr_coulomb::{EPS_Q, PLASTIC_STRAIN};
+        let dep = self.compose_strain(plastic);
+        for (p, d) in state.internal[PLASTIC_STRAIN..PLASTIC_STRAIN + 4]
+            .iter_mut()
+            .zip(dep)
+        {
+            *p += d;
+        }
+        state.internal[EPS_Q] += super::layout::equivalent_plastic_strain(&dep);
+        super::MaterialResponse {
+            s: self.compose(values),
+            d: product(&self.isotropic_tangent(values, dv), trial_d),
+            state,
+        }
+    }
+
     /// The map of tensor-shear Voigt stresses into the eigenframe (`sign` 1) or back (−1).
     fn frame_map(&self, sign: f64) -> [[f64; 4]; 4] {
         let (c, s) = (self.cos, sign * self.sin);

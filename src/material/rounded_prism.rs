@@ -62,6 +62,13 @@ fn criterion(s: &[f64; 3], d: f64) -> (f64, [f64; 3], [[f64; 3]; 3]) {
     (g, grad, hess)
 }
 
+/// I + k ∇²g: the matrix of the return's linearisation (Ξ⁻¹ of the module docs).
+fn relaxed(hess: &[[f64; 3]; 3], k: f64) -> [[f64; 3]; 3] {
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| if i == j { 1.0 } else { 0.0 } + k * hess[i][j])
+    })
+}
+
 /// The largest |σ1 − σ3| the rounded prism admits on an edge (two equal principal stresses):
 /// 2cu less about δ/2.
 pub fn edge_strength(cu: f64) -> f64 {
@@ -117,9 +124,7 @@ pub fn principal_return(
         }
         let (_, n, hess) = criterion(&s, d);
         // [[I + 2GΔλH, 2Gn], [nᵀ, 0]] [ds; dλ] = −[rs; rf], by eliminating ds.
-        let a: [[f64; 3]; 3] = std::array::from_fn(|i| {
-            std::array::from_fn(|j| (i == j) as u8 as f64 + two_g * dl * hess[i][j])
-        });
+        let a = relaxed(&hess, two_g * dl);
         let xr = solve_small(3, &a, &rs);
         let xn = solve_small(3, &a, &n.map(|v| two_g * v));
         let (Some(xr), Some(xn)) = (xr, xn) else {
@@ -160,9 +165,7 @@ pub fn principal_return(
         }
     }
     let (_, n, hess) = criterion(&s, d);
-    let a: [[f64; 3]; 3] = std::array::from_fn(|i| {
-        std::array::from_fn(|j| (i == j) as u8 as f64 + two_g * dl * hess[i][j])
-    });
+    let a = relaxed(&hess, two_g * dl);
     let mut xi = [[0.0; 3]; 3];
     for c in 0..3 {
         let mut unit = [0.0; 3];

@@ -44,8 +44,8 @@
 //! Cauchy stress), and the end-of-step Cauchy stress is on the yield surface to round-off.
 
 use super::elastic::LinearElastic;
-use super::layout::{equivalent_plastic_strain, grew, internal_len};
-use super::principal::{product, Spectral};
+use super::layout::{grew, internal_len};
+use super::principal::Spectral;
 use super::rounded_prism;
 use super::{GaussState, InternalVar, Material, MaterialError, MaterialResponse};
 
@@ -382,19 +382,7 @@ impl Tresca {
         // The relief is deviatoric (the flow is), so the plastic strain is it over 2G.
         let relief: [f64; 3] =
             std::array::from_fn(|i| (frame.values[i] - values[i]) / (2.0 * self.shear_modulus()));
-        let dep = frame.compose_strain(&relief);
-        for (p, d) in state.internal[PLASTIC_STRAIN..PLASTIC_STRAIN + 4]
-            .iter_mut()
-            .zip(dep)
-        {
-            *p += d;
-        }
-        state.internal[EPS_Q] += equivalent_plastic_strain(&dep);
-        Ok(MaterialResponse {
-            s: frame.compose(&values),
-            d: product(&frame.isotropic_tangent(&values, &dv), &trial.d),
-            state,
-        })
+        Ok(frame.returned(&values, &dv, &relief, &trial.d, state))
     }
 }
 
