@@ -116,6 +116,8 @@ impl Simulation {
         } else {
             &none
         };
+        // Each pair's distance to its body at the start (to keep the nearest body's pair).
+        let mut start_distance = Vec::new();
         for (bi, body) in model.bodies.iter().enumerate() {
             let shape = &out.bodies[bi];
             let shape_from = body.shape(from);
@@ -193,10 +195,38 @@ impl Simulation {
                     free,
                 });
                 out.spacing.push(h);
+                start_distance.push(start);
             }
         }
+        keep_nearest_body(&mut out, &start_distance);
         out
     }
+}
+
+/// A node near two bodies (a cone and the shaft above it, two bodies moving as one) holds its
+/// rows for one law only: it keeps the pair of the body it starts nearest to (the lower body
+/// index on a tie), so that the choice does not depend on the partition.
+fn keep_nearest_body(out: &mut BoundaryLoads, start_distance: &[f64]) {
+    let mut best: HashMap<u32, usize> = HashMap::new();
+    for (i, pair) in out.pairs.iter().enumerate() {
+        best.entry(pair.node)
+            .and_modify(|b| {
+                if start_distance[i] < start_distance[*b] {
+                    *b = i;
+                }
+            })
+            .or_insert(i);
+    }
+    if best.len() == out.pairs.len() {
+        return;
+    }
+    let keep: Vec<bool> = (0..out.pairs.len())
+        .map(|i| best[&out.pairs[i].node] == i)
+        .collect();
+    let mut k = keep.iter();
+    out.pairs.retain(|_| *k.next().unwrap_or(&false));
+    let mut k = keep.iter();
+    out.spacing.retain(|_| *k.next().unwrap_or(&false));
 }
 
 impl Simulation {
