@@ -773,6 +773,9 @@ impl Simulation {
             }
             self.particles.increment[i] = [per_step * d[0], per_step * d[1]];
         }
+        if self.model.scene.analysis.has_hoop() {
+            self.particles.snap_to_axis();
+        }
         let last = (0..solved.dofs.n_nodes()).map(|n| {
             let d = solved.du[n];
             let v = [per_step * d[0], per_step * d[1], solved.pressure[n]];
