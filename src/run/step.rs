@@ -458,7 +458,7 @@ impl Simulation {
             symmetric: self.symmetric_tangent(),
             scene: solver.linear,
         };
-        let cl = CommandLine::read(world, solver.reuse_factorisation)?;
+        let cl = CommandLine::read(world, solver.linear, solver.reuse_factorisation)?;
         let plan = LinearPlan::choose(&facts, &cl).map_err(|message| PetscError {
             code: crate::petsc::error::PETSC_ERR_USER,
             message,

@@ -279,15 +279,13 @@ impl fmt::Display for LinearPath {
                      {runner}), inexact Newton"
                 )
             }
-            LinearPath::FieldSplit { yield_zone } => write!(
-                f,
-                "GMRES with a Schur field split (GAMG{} on the displacements)",
-                if *yield_zone {
-                    " and the yield zone"
-                } else {
-                    ""
-                }
+            LinearPath::FieldSplit { yield_zone: true } => f.write_str(
+                "yield-zone, GMRES with a Schur field split (GAMG and an exact solve on the \
+                 yielded rows of the displacements)",
             ),
+            LinearPath::FieldSplit { yield_zone: false } => {
+                f.write_str("amg, GMRES with a Schur field split (GAMG on the displacements)")
+            }
         }
     }
 }
@@ -453,16 +451,18 @@ impl fmt::Display for LinearPlan {
             )?,
         }
         match self.origin {
-            Origin::Scene(choice) => {
-                let name = match choice {
-                    LinearChoice::Auto => "auto",
-                    LinearChoice::Direct => "direct",
-                    LinearChoice::Iterative => "iterative",
-                };
-                write!(f, " (solver.linear = \"{name}\")")
-            }
+            Origin::Scene(choice) => write!(f, " (solver.linear = \"{}\")", scene_name(choice)),
             Origin::CommandLine(named) => write!(f, " (-pfem_linear_solver {named})"),
         }
+    }
+}
+
+/// `solver.linear`'s value as the scene writes it.
+pub fn scene_name(choice: LinearChoice) -> &'static str {
+    match choice {
+        LinearChoice::Auto => "auto",
+        LinearChoice::Direct => "direct",
+        LinearChoice::Iterative => "iterative",
     }
 }
 

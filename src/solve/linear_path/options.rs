@@ -155,10 +155,11 @@ const REUSE_MAX_KRYLOV: usize = 4;
 const REUSE_RTOL: f64 = 1e-10;
 
 impl CommandLine {
-    /// Collective. Reads the options, registering pfem-mpi's own with `-help`;
-    /// `reuse_factorisation` is the scene's default for `-pfem_lu_reuse`.
+    /// Collective. Reads the options, registering pfem-mpi's own with `-help`; `scene` and
+    /// `reuse_factorisation` are the scene's `solver.linear` and default for `-pfem_lu_reuse`.
     pub fn read(
         comm: &SimpleCommunicator,
+        scene: crate::scene::LinearChoice,
         reuse_factorisation: bool,
     ) -> Result<CommandLine, PetscError> {
         let as_user_error = |message: String| PetscError {
@@ -174,7 +175,7 @@ impl CommandLine {
                 LINEAR_SOLVER,
                 "The linear solver path, overriding solver.linear (docs/guide/solvers.md)",
                 &NAMES,
-                "the scene's solver.linear",
+                super::scene_name(scene),
             )?
             .map(|i| Named::ALL[i]);
         let pmg = block.flag(
