@@ -1,4 +1,5 @@
 use super::*;
+use crate::scene::LinearChoice;
 
 fn facts(mixed: bool, plastic: bool, scene: LinearChoice) -> Facts {
     Facts {
