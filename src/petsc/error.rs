@@ -3,7 +3,7 @@ use std::ffi::CStr;
 use std::fmt;
 
 /// PETSc's `PETSC_ERR_USER`: the code our callbacks return, and our own failures carry.
-pub(super) const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
+pub(crate) const PETSC_ERR_USER: ffi::PetscErrorCode = 83;
 
 /// A PETSc call that returned a non-zero error code, or a callback of ours that failed.
 #[derive(Debug, Clone)]

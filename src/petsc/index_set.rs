@@ -42,6 +42,47 @@ impl IndexSet {
         }
     }
 
+    /// Collective. This rank's `indices` (copied), on the communicator of `like`.
+    pub fn general_like(
+        like: &impl super::object::Object,
+        indices: &[Int],
+    ) -> Result<IndexSet, PetscError> {
+        let comm = super::object::comm_of(like)?;
+        let mut raw: ffi::IS = std::ptr::null_mut();
+        // SAFETY: the index array is valid for its length and copied.
+        check(
+            unsafe {
+                ffi::ISCreateGeneral(
+                    comm,
+                    to_int(indices.len(), "index set")?,
+                    indices.as_ptr(),
+                    ffi::PetscCopyMode_PETSC_COPY_VALUES,
+                    &mut raw,
+                )
+            },
+            "ISCreateGeneral",
+        )?;
+        Ok(IndexSet { raw })
+    }
+
+    /// A reference of our own to this index set.
+    pub fn shared(&self) -> Result<IndexSet, PetscError> {
+        // SAFETY: live index set.
+        check(
+            unsafe { ffi::PetscObjectReference(self.raw as ffi::PetscObject) },
+            "PetscObjectReference",
+        )?;
+        Ok(IndexSet { raw: self.raw })
+    }
+
+    /// Collective. Indices over all ranks.
+    pub fn global_size(&self) -> Result<Int, PetscError> {
+        let mut n: Int = 0;
+        // SAFETY: live index set.
+        check(unsafe { ffi::ISGetSize(self.raw, &mut n) }, "ISGetSize")?;
+        Ok(n)
+    }
+
     /// Attaches the near-null space PCFIELDSPLIT hands to this field's diagonal block (it
     /// queries the index set for "nearnullspace" when it extracts the block).
     pub fn compose_near_null_space(&self, space: &NullSpace) -> Result<(), PetscError> {

@@ -215,27 +215,12 @@ impl Mat {
 
     /// Collective. The product `self * x` into `y`.
     pub fn mult(&self, x: super::VecRef, y: super::VecRef) -> Result<(), PetscError> {
-        // SAFETY: live handles with matching layouts (PETSc checks the sizes).
-        check(unsafe { ffi::MatMult(self.raw, x.raw, y.raw) }, "MatMult")
+        self.as_ref().mult(x, y)
     }
 
     /// Collective. The rows and columns `is` of this matrix (a block of a block system).
     pub fn sub_matrix(&self, is: &IndexSet) -> Result<Mat, PetscError> {
-        let mut raw: ffi::Mat = std::ptr::null_mut();
-        // SAFETY: live handles; the new matrix is ours.
-        check(
-            unsafe {
-                ffi::MatCreateSubMatrix(
-                    self.raw,
-                    is.raw,
-                    is.raw,
-                    ffi::MatReuse_MAT_INITIAL_MATRIX,
-                    &mut raw,
-                )
-            },
-            "MatCreateSubMatrix",
-        )?;
-        Ok(Mat { raw })
+        self.as_ref().sub_matrix(is)
     }
 }
 
@@ -291,6 +276,120 @@ impl MatRef<'_> {
             raw,
             _owner: PhantomData,
         }
+    }
+
+    /// A reference of our own to this matrix, which keeps it alive.
+    pub fn shared(&self) -> Result<Mat, PetscError> {
+        // SAFETY: live matrix.
+        check(
+            unsafe { ffi::PetscObjectReference(self.raw as ffi::PetscObject) },
+            "PetscObjectReference",
+        )?;
+        Ok(Mat { raw: self.raw })
+    }
+
+    /// Collective. y = A x.
+    pub fn mult(&self, x: super::VecRef<'_>, y: super::VecRef<'_>) -> Result<(), PetscError> {
+        // SAFETY: live handles with matching layouts (PETSc checks the sizes).
+        check(unsafe { ffi::MatMult(self.raw, x.raw, y.raw) }, "MatMult")
+    }
+
+    /// Collective. x = Aᵀ y.
+    pub fn mult_transpose(
+        &self,
+        y: super::VecRef<'_>,
+        x: super::VecRef<'_>,
+    ) -> Result<(), PetscError> {
+        // SAFETY: live handles with matching layouts.
+        check(
+            unsafe { ffi::MatMultTranspose(self.raw, y.raw, x.raw) },
+            "MatMultTranspose",
+        )
+    }
+
+    /// Collective. z = y + A x (z may be y).
+    pub fn mult_add(
+        &self,
+        x: super::VecRef<'_>,
+        y: super::VecRef<'_>,
+        z: super::VecRef<'_>,
+    ) -> Result<(), PetscError> {
+        // SAFETY: live handles with matching layouts.
+        check(
+            unsafe { ffi::MatMultAdd(self.raw, x.raw, y.raw, z.raw) },
+            "MatMultAdd",
+        )
+    }
+
+    /// The diagonal into `d`.
+    pub fn diagonal(&self, d: super::VecRef<'_>) -> Result<(), PetscError> {
+        // SAFETY: live handles.
+        check(
+            unsafe { ffi::MatGetDiagonal(self.raw, d.raw) },
+            "MatGetDiagonal",
+        )
+    }
+
+    /// Collective. New vectors of the column layout and of the row layout.
+    pub fn vectors(&self) -> Result<(super::PVec, super::PVec), PetscError> {
+        let (mut right, mut left): (ffi::Vec, ffi::Vec) =
+            (std::ptr::null_mut(), std::ptr::null_mut());
+        // SAFETY: live matrix; both vectors are ours.
+        check(
+            unsafe { ffi::MatCreateVecs(self.raw, &mut right, &mut left) },
+            "MatCreateVecs",
+        )?;
+        Ok((super::PVec { raw: right }, super::PVec { raw: left }))
+    }
+
+    /// Collective. A new vector of the column layout.
+    pub fn right_vector(&self) -> Result<super::PVec, PetscError> {
+        let mut right: ffi::Vec = std::ptr::null_mut();
+        // SAFETY: live matrix; the vector is ours.
+        check(
+            unsafe { ffi::MatCreateVecs(self.raw, &mut right, std::ptr::null_mut()) },
+            "MatCreateVecs",
+        )?;
+        Ok(super::PVec { raw: right })
+    }
+
+    /// Global rows.
+    pub fn global_rows(&self) -> Result<Int, PetscError> {
+        let mut rows: Int = 0;
+        // SAFETY: live matrix.
+        check(
+            unsafe { ffi::MatGetSize(self.raw, &mut rows, std::ptr::null_mut()) },
+            "MatGetSize",
+        )?;
+        Ok(rows)
+    }
+
+    /// Collective. The rows and columns `is` of this matrix.
+    pub fn sub_matrix(&self, is: &IndexSet) -> Result<Mat, PetscError> {
+        let mut raw: ffi::Mat = std::ptr::null_mut();
+        // SAFETY: live handles; the new matrix is ours.
+        check(
+            unsafe {
+                ffi::MatCreateSubMatrix(
+                    self.raw,
+                    is.raw,
+                    is.raw,
+                    ffi::MatReuse_MAT_INITIAL_MATRIX,
+                    &mut raw,
+                )
+            },
+            "MatCreateSubMatrix",
+        )?;
+        Ok(Mat { raw })
+    }
+
+    /// Collective. Drops the near-null space.
+    pub fn clear_near_null_space(&self) -> Result<(), PetscError> {
+        // SAFETY: live matrix.
+        check(
+            unsafe { ffi::MatSetNearNullSpace(self.raw, std::ptr::null_mut()) },
+            "MatSetNearNullSpace",
+        )
     }
 
     pub fn zero_entries(&self) -> Result<(), PetscError> {

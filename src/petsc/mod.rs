@@ -5,16 +5,19 @@ pub mod error;
 pub mod ffi;
 pub mod index_set;
 pub mod init;
-pub mod linear;
+pub mod ksp;
 pub mod matrix;
 pub mod nullspace;
+pub mod object;
+pub mod options;
+pub mod pc;
+pub mod pc_shell;
 pub mod reason;
 pub mod scatter;
 pub mod shell;
 pub mod snes;
-mod two_level;
 pub mod vector;
-mod yield_zone;
+pub mod viewer;
 
 /// PETSc's integer as the bindings define it (32 or 64 bits by build): every index and count
 /// handed to PETSc has this type, converted with a check ([`matrix::to_int`]).
@@ -41,45 +44,18 @@ unsafe fn has_type(object: ffi::PetscObject, name: &str) -> Result<bool, PetscEr
     Ok(same == ffi::PetscBool_PETSC_TRUE)
 }
 
-/// The context of `pc` if it is a PCSHELL named `name` (our shells tell themselves apart by
-/// name: a context of one read as another's would be undefined behaviour).
-///
-/// # Safety
-/// `pc` must be a live PC.
-unsafe fn shell_context(
-    pc: ffi::PC,
-    name: &str,
-) -> Result<Option<*mut std::ffi::c_void>, PetscError> {
-    // SAFETY: as the caller promises; the name PETSc returns lives as long as the PC.
-    unsafe {
-        if !has_type(pc as ffi::PetscObject, "shell")? {
-            return Ok(None);
-        }
-        let mut given: *const std::os::raw::c_char = std::ptr::null();
-        error::check(ffi::PCShellGetName(pc, &mut given), "PCShellGetName")?;
-        if given.is_null() || std::ffi::CStr::from_ptr(given).to_bytes() != name.as_bytes() {
-            return Ok(None);
-        }
-        let mut raw: *mut std::ffi::c_void = std::ptr::null_mut();
-        error::check(
-            ffi::PCShellGetContext(
-                pc,
-                &mut raw as *mut *mut std::ffi::c_void as *mut std::ffi::c_void,
-            ),
-            "PCShellGetContext",
-        )?;
-        Ok((!raw.is_null()).then_some(raw))
-    }
-}
-
 pub use error::PetscError;
 pub use index_set::IndexSet;
 pub use init::Petsc;
-pub use linear::{FactorReuse, LinearSolver};
+pub use ksp::{Ksp, KspRef};
 pub use matrix::{Mat, MatRef};
 pub use nullspace::NullSpace;
+pub use object::Object;
+pub use pc::{Pc, PcRef};
+pub use pc_shell::ShellPreconditioner;
 pub use reason::{Divergence, KspDiverged, SnesDiverged, SolveFailure};
-pub use scatter::Scatter;
+pub use scatter::{IndexScatter, Scatter};
 pub use shell::LinearOperator;
-pub use snes::{NonlinearProblem, Snes, SolveStats};
+pub use snes::{LineSearchRef, NonlinearProblem, Snes, SnesRef, SolveStats};
 pub use vector::{PVec, VecRef};
+pub use viewer::ViewerRef;

@@ -121,3 +121,79 @@ impl Drop for Scatter {
         }
     }
 }
+
+/// Moves the entries `is` of a distributed vector to every entry of another (made for them)
+/// and back: made once, applied many times (a sub-vector of an arbitrary index set would
+/// build its scatter at every use).
+pub struct IndexScatter {
+    raw: ffi::VecScatter,
+}
+
+impl IndexScatter {
+    /// Collective. From the entries `is` of vectors laid out as `from` to vectors laid out as
+    /// `to`.
+    pub fn new(
+        from: VecRef<'_>,
+        is: &super::IndexSet,
+        to: VecRef<'_>,
+    ) -> Result<IndexScatter, PetscError> {
+        let mut raw: ffi::VecScatter = std::ptr::null_mut();
+        // SAFETY: live handles; the scatter is ours.
+        check(
+            unsafe {
+                ffi::VecScatterCreate(from.raw, is.raw, to.raw, std::ptr::null_mut(), &mut raw)
+            },
+            "VecScatterCreate",
+        )?;
+        Ok(IndexScatter { raw })
+    }
+
+    /// Collective. to = from[is].
+    pub fn forward(&self, from: VecRef<'_>, to: VecRef<'_>) -> Result<(), PetscError> {
+        self.run(
+            from,
+            to,
+            ffi::InsertMode_INSERT_VALUES,
+            ffi::ScatterMode_SCATTER_FORWARD,
+        )
+    }
+
+    /// Collective. into[is] = from, or into[is] += from with `add`.
+    pub fn reverse(&self, from: VecRef<'_>, into: VecRef<'_>, add: bool) -> Result<(), PetscError> {
+        let mode = if add {
+            ffi::InsertMode_ADD_VALUES
+        } else {
+            ffi::InsertMode_INSERT_VALUES
+        };
+        self.run(from, into, mode, ffi::ScatterMode_SCATTER_REVERSE)
+    }
+
+    fn run(
+        &self,
+        x: VecRef<'_>,
+        y: VecRef<'_>,
+        insert: ffi::InsertMode,
+        mode: ffi::ScatterMode,
+    ) -> Result<(), PetscError> {
+        // SAFETY: live handles of the layouts the scatter was made for (PETSc checks).
+        unsafe {
+            check(
+                ffi::VecScatterBegin(self.raw, x.raw, y.raw, insert, mode),
+                "VecScatterBegin",
+            )?;
+            check(
+                ffi::VecScatterEnd(self.raw, x.raw, y.raw, insert, mode),
+                "VecScatterEnd",
+            )
+        }
+    }
+}
+
+impl Drop for IndexScatter {
+    fn drop(&mut self) {
+        // SAFETY: we own the scatter.
+        unsafe {
+            ffi::VecScatterDestroy(&mut self.raw);
+        }
+    }
+}

@@ -1,12 +1,11 @@
 use super::error::{check, PetscError, PETSC_ERR_USER};
 use super::ffi;
 use super::init::cstring;
-use super::linear::{bool_option, FactorReuse, LinearSolver};
+use super::ksp::KspRef;
 use super::matrix::{to_int, Mat, MatRef};
+use super::object::object;
 use super::reason::{Divergence, KspDiverged, SnesDiverged, SolveFailure};
-use super::two_level;
 use super::vector::{PVec, VecRef};
-use super::yield_zone;
 use mpi::raw::AsRaw;
 use mpi::topology::SimpleCommunicator;
 use std::ffi::c_void;
@@ -28,17 +27,11 @@ pub trait NonlinearProblem {
     fn residual(&mut self, x: VecRef<'_>, f: VecRef<'_>) -> Result<(), CallbackError>;
     /// Collective. Consistent tangent dF/dx at `x` into `j` (assembled on return).
     fn jacobian(&mut self, x: VecRef<'_>, j: MatRef<'_>) -> Result<(), CallbackError>;
-    /// The Richardson damping of one Jacobi sweep on the last Jacobian, the same on every
-    /// rank, where the problem knows a bound on its spectrum: the p-multigrid's smoother
-    /// ([`LinearSolver::damps_jacobi_smoother`]) then needs no eigenvalue estimate.
-    fn smoother_damping(&self) -> Option<f64> {
-        None
-    }
-    /// The global displacement dofs of the triangles whose tangent has yielded at the last
-    /// Jacobian (this rank's triangles; repeats allowed), for the linear solver's yield zone
-    /// ([`super::yield_zone`]). Asked once after every Jacobian where the zone is in use.
-    fn yielded_dofs(&mut self) -> Vec<usize> {
-        Vec::new()
+    /// Collective. What the linear solver takes from the Jacobian just assembled at `x`
+    /// (its preconditioners' parts, set up before the linear solve): nothing by default.
+    fn after_jacobian(&mut self, snes: SnesRef<'_>, x: VecRef<'_>) -> Result<(), PetscError> {
+        let _ = (snes, x);
+        Ok(())
     }
 }
 
@@ -53,40 +46,29 @@ pub struct SolveStats {
 /// A SNES we own; destroyed on drop.
 pub struct Snes {
     raw: ffi::SNES,
-    reuse: Option<FactorReuse>,
-    /// The p-multigrid's fine smoother takes its damping from each Jacobian's spectral bound
-    /// ([`LinearSolver::damps_jacobi_smoother`]).
-    damped_smoother: bool,
-    /// The p-multigrid's coarse solver is set up from the first Jacobian of a solve
-    /// ([`set_up_coarse_solver`]).
-    coarse_first: bool,
 }
+
+/// A SNES borrowed for the length of one of its callbacks.
+#[derive(Clone, Copy)]
+pub struct SnesRef<'a> {
+    raw: ffi::SNES,
+    _owner: std::marker::PhantomData<&'a ()>,
+}
+
+/// A SNES's line search, borrowed.
+#[derive(Clone, Copy)]
+pub struct LineSearchRef<'a> {
+    raw: ffi::SNESLineSearch,
+    _owner: std::marker::PhantomData<&'a ()>,
+}
+
+object!(Snes, SnesRef<'_>, LineSearchRef<'_>);
 
 struct Ctx<'a> {
     problem: &'a mut dyn NonlinearProblem,
     error: Option<String>,
     /// The last domain error's message: the divergence reports it (a UMAT's PNEWDT or NaN).
     domain: Option<String>,
-    reuse: Option<FactorReuse>,
-    /// The residual norm at the last Jacobian of this solve.
-    last_norm: Option<f64>,
-    damped_smoother: bool,
-    /// Set up the p-multigrid's coarse solver at the next Jacobian (the first of the solve).
-    coarse_first: bool,
-}
-
-/// Collective. Hands the problem's yielded dofs to the yield zone (the field split's or the
-/// whole system's), if the linear solver has one.
-fn update_yield_zone(snes: ffi::SNES, x: VecRef<'_>, ctx: &mut Ctx) -> Result<(), PetscError> {
-    // SAFETY: the SNES is live during its callback; its PCs are borrowed from it.
-    unsafe {
-        let pc = preconditioner(snes)?;
-        if let Some(block) = yield_zone::find(pc)? {
-            let dofs = ctx.problem.yielded_dofs();
-            yield_zone::set_zone(block, x, &dofs)?;
-        }
-    }
-    Ok(())
 }
 
 /// Newton also stops when its update is this small relative to the solution: with a good
@@ -95,34 +77,25 @@ fn update_yield_zone(snes: ffi::SNES, x: VecRef<'_>, ctx: &mut Ctx) -> Result<()
 const STEP_TOL: f64 = 1e-10;
 
 impl Snes {
-    /// Collective. Newton with the caller's line search and linear solver. The direct solver
-    /// (MUMPS LU) is robust for the indefinite saddle points of nearly incompressible soil and
-    /// fast on 1-3 ranks, where SuperLU_dist stalled on 3 oversubscribed ranks. MUMPS on several
-    /// ranks sums contribution blocks in message-arrival order, so two identical multi-rank runs
-    /// agree to round-off, not bit for bit; `-pc_factor_mat_solver_type superlu_dist` is bitwise
-    /// reproducible on 2 ranks. Every choice is overridable by PETSc options on the command line.
+    /// Collective. Newton converged when the residual falls below `abstol` or by `rtol`, or
+    /// its update below [`STEP_TOL`] of the solution, in at most `max_it` iterations. The
+    /// direct solver (MUMPS LU) is robust for the indefinite saddle points of nearly
+    /// incompressible soil and fast on 1-3 ranks, where SuperLU_dist stalled on 3
+    /// oversubscribed ranks. MUMPS on several ranks sums contribution blocks in message-arrival
+    /// order, so two identical multi-rank runs agree to round-off, not bit for bit;
+    /// `-pc_factor_mat_solver_type superlu_dist` is bitwise reproducible on 2 ranks. Every
+    /// choice is overridable by PETSc options on the command line ([`Snes::set_from_options`]).
     pub fn new(
         comm: &SimpleCommunicator,
         abstol: f64,
         rtol: f64,
         max_it: usize,
-        line_search: &str,
-        linear: &LinearSolver,
     ) -> Result<Snes, PetscError> {
         let mut raw: ffi::SNES = std::ptr::null_mut();
-        // SAFETY: fresh handle; KSP/PC are borrowed from the SNES and not destroyed by us.
+        // SAFETY: fresh handle, owned from the next line on.
         unsafe {
             check(ffi::SNESCreate(comm.as_raw(), &mut raw), "SNESCreate")?;
-            let reuse = match linear {
-                LinearSolver::Direct { reuse, .. } => *reuse,
-                _ => None,
-            };
-            let snes = Snes {
-                raw,
-                reuse,
-                damped_smoother: linear.damps_jacobi_smoother()?,
-                coarse_first: matches!(linear, LinearSolver::PMultigrid { .. }),
-            };
+            let snes = Snes { raw };
             check(
                 ffi::SNESSetTolerances(
                     raw,
@@ -134,50 +107,80 @@ impl Snes {
                 ),
                 "SNESSetTolerances",
             )?;
-            let mut ksp: ffi::KSP = std::ptr::null_mut();
-            check(ffi::SNESGetKSP(raw, &mut ksp), "SNESGetKSP")?;
-            linear.configure(ksp)?;
+            Ok(snes)
+        }
+    }
+
+    /// The linear solver, borrowed.
+    pub fn ksp(&self) -> Result<KspRef<'_>, PetscError> {
+        // SAFETY: live SNES.
+        unsafe { ksp_of(self.raw) }
+    }
+
+    /// Newton iterations one preconditioner serves (it is built afresh at the start of every
+    /// Newton solve).
+    pub fn set_lag_preconditioner(&self, lag: usize) -> Result<(), PetscError> {
+        let lag = to_int(lag, "preconditioner lag")?;
+        // SAFETY: live SNES.
+        check(
+            unsafe { ffi::SNESSetLagPreconditioner(self.raw, lag) },
+            "SNESSetLagPreconditioner",
+        )
+    }
+
+    /// Inexact Newton: each linear solve's tolerance by Eisenstat and Walker (PETSc's
+    /// default version), at most `cap`.
+    pub fn use_eisenstat_walker(&self, cap: f64) -> Result<(), PetscError> {
+        let default = ffi::PETSC_DEFAULT as f64;
+        // SAFETY: live SNES.
+        unsafe {
             check(
-                ffi::SNESSetLagPreconditioner(
-                    raw,
-                    to_int(linear.preconditioner_lag(), "preconditioner lag")?,
-                ),
-                "SNESSetLagPreconditioner",
+                ffi::SNESKSPSetUseEW(self.raw, ffi::PetscBool_PETSC_TRUE),
+                "SNESKSPSetUseEW",
             )?;
-            if let Some(cap) = linear.inexact_newton_cap() {
-                let default = ffi::PETSC_DEFAULT as f64;
-                check(
-                    ffi::SNESKSPSetUseEW(raw, ffi::PetscBool_PETSC_TRUE),
-                    "SNESKSPSetUseEW",
-                )?;
-                check(
-                    ffi::SNESKSPSetParametersEW(
-                        raw,
-                        ffi::PETSC_DEFAULT as ffi::PetscInt,
-                        default,
-                        cap,
-                        default,
-                        default,
-                        default,
-                        default,
-                    ),
-                    "SNESKSPSetParametersEW",
-                )?;
-            }
-            // The caller's line search: full steps for elastic large rotations (the residual grows
-            // on the first iterate before the quadratic phase, and backtracking would crawl),
-            // backtracking for plastic flow (elastic-plastic switching overshoots).
-            let mut ls: ffi::SNESLineSearch = std::ptr::null_mut();
-            check(ffi::SNESGetLineSearch(raw, &mut ls), "SNESGetLineSearch")?;
-            let kind = cstring(line_search)?;
+            check(
+                ffi::SNESKSPSetParametersEW(
+                    self.raw,
+                    ffi::PETSC_DEFAULT as ffi::PetscInt,
+                    default,
+                    cap,
+                    default,
+                    default,
+                    default,
+                    default,
+                ),
+                "SNESKSPSetParametersEW",
+            )
+        }
+    }
+
+    /// The line search's type: full steps for elastic large rotations (the residual grows on
+    /// the first iterate before the quadratic phase, and backtracking would crawl),
+    /// backtracking for plastic flow (elastic-plastic switching overshoots).
+    pub fn set_line_search(&self, kind: &str) -> Result<(), PetscError> {
+        let mut ls: ffi::SNESLineSearch = std::ptr::null_mut();
+        let kind = cstring(kind)?;
+        // SAFETY: live SNES; its line search is borrowed.
+        unsafe {
+            check(
+                ffi::SNESGetLineSearch(self.raw, &mut ls),
+                "SNESGetLineSearch",
+            )?;
             check(
                 ffi::SNESLineSearchSetType(ls, kind.as_ptr()),
                 "SNESLineSearchSetType",
-            )?;
-            check(ffi::SNESSetFromOptions(raw), "SNESSetFromOptions")
-                .map_err(PetscError::naming_user_options)?;
-            Ok(snes)
+            )
         }
+    }
+
+    /// Collective. Reads the command line's options, which override every choice made before.
+    pub fn set_from_options(&self) -> Result<(), PetscError> {
+        // SAFETY: live SNES.
+        check(
+            unsafe { ffi::SNESSetFromOptions(self.raw) },
+            "SNESSetFromOptions",
+        )
+        .map_err(PetscError::naming_user_options)
     }
 
     /// Collective. Solves F(x) = 0 starting from `x`; `jac` holds the preallocated pattern.
@@ -192,10 +195,6 @@ impl Snes {
             problem,
             error: None,
             domain: None,
-            reuse: self.reuse,
-            last_norm: None,
-            damped_smoother: self.damped_smoother,
-            coarse_first: self.coarse_first,
         };
         let ctx_ptr = &mut ctx as *mut Ctx as *mut c_void;
         // SAFETY: ctx outlives SNESSolve, the only place the callbacks run; the callbacks catch
@@ -301,29 +300,12 @@ impl Snes {
 }
 
 impl Snes {
-    /// Whether the p-multigrid's fine smoother takes its damping from each Jacobian
-    /// ([`NonlinearProblem::smoother_damping`]): the problem must then give one.
-    pub fn damps_smoother(&self) -> bool {
-        self.damped_smoother
-    }
-
     /// Collective. Frees what the last solve set up (work vectors, the preconditioner's
     /// hierarchy and the Krylov method's vectors), keeping the configuration; the next solve
-    /// sets up again. The end of an increment's solver: the p-multigrid's coarse operator lost
-    /// its rigid-body modes after GAMG's first aggregation, so a solve after a reset would
-    /// aggregate without them, and the field split drops its splits (and with them the
-    /// displacement block's yield zone); each increment makes its iterative solver afresh.
+    /// sets up again.
     pub fn reset(&mut self) -> Result<(), PetscError> {
-        // SAFETY: live SNES we own; its PC is borrowed from it; the matrices and vectors it
-        // referenced stay owned by us. The two-level cycle has no reset of its own.
-        unsafe {
-            let pc = preconditioner(self.raw)?;
-            two_level::reset(pc)?;
-            if let Some(block) = yield_zone::find(pc)? {
-                yield_zone::reset(block)?;
-            }
-            check(ffi::SNESReset(self.raw), "SNESReset")
-        }
+        // SAFETY: live SNES we own; the matrices and vectors it referenced stay ours.
+        check(unsafe { ffi::SNESReset(self.raw) }, "SNESReset")
     }
 }
 
@@ -406,7 +388,9 @@ unsafe extern "C" fn jacobian_cb(
     }
     let after = catch_unwind(AssertUnwindSafe(|| {
         // SAFETY: PETSc keeps x alive during the callback.
-        after_jacobian(snes, unsafe { VecRef::lent(x) }, ctx)
+        // SAFETY: PETSc keeps the SNES alive during its callback.
+        let snes = unsafe { SnesRef::lent(snes) };
+        ctx.problem.after_jacobian(snes, unsafe { VecRef::lent(x) })
     }));
     let message = match after {
         Ok(Ok(())) => return 0,
@@ -417,222 +401,116 @@ unsafe extern "C" fn jacobian_cb(
     PETSC_ERR_USER
 }
 
-/// Collective. What the linear solver takes from a new Jacobian at `x`: the p-multigrid's
-/// smoother damping, the yield zone, the coarse solver's first set-up, and whether a kept
-/// factorisation is refreshed.
-fn after_jacobian(snes: ffi::SNES, x: VecRef<'_>, ctx: &mut Ctx) -> Result<(), PetscError> {
-    if ctx.damped_smoother {
-        let damping = ctx.problem.smoother_damping().ok_or_else(|| PetscError {
-            code: PETSC_ERR_USER,
-            message: "the p-multigrid's Jacobi smoother has no damping: this Jacobian gave no \
-                      finite bound on its spectrum (an element tangent with a negative or zero \
-                      diagonal, or not a number)"
-                .into(),
-        })?;
-        damp_smoother(snes, damping)?;
-    }
-    update_yield_zone(snes, x, ctx)?;
-    if ctx.coarse_first {
-        ctx.coarse_first = false;
-        set_up_coarse_solver(snes)?;
-        share_work_vector(snes, x)?;
-    }
-    if let Some(reuse) = ctx.reuse {
-        choose_factorisation(snes, &reuse, &mut ctx.last_norm)?;
-    }
-    Ok(())
-}
-
-/// The preconditioner of `snes`'s linear solver, borrowed from it.
+/// The KSP of `snes`, borrowed.
 ///
 /// # Safety
-/// `snes` must be live; the PC must not outlive it.
-unsafe fn preconditioner(snes: ffi::SNES) -> Result<ffi::PC, PetscError> {
+/// `snes` must be live for `'a`.
+unsafe fn ksp_of<'a>(snes: ffi::SNES) -> Result<KspRef<'a>, PetscError> {
     let mut ksp: ffi::KSP = std::ptr::null_mut();
-    let mut pc: ffi::PC = std::ptr::null_mut();
-    // SAFETY: as the caller promises.
+    // SAFETY: as the caller promises; the KSP lives as long as the SNES.
     unsafe {
         check(ffi::SNESGetKSP(snes, &mut ksp), "SNESGetKSP")?;
-        check(ffi::KSPGetPC(ksp, &mut pc), "KSPGetPC")?;
-    }
-    Ok(pc)
-}
-
-/// Sets the Richardson damping of the p-multigrid's fine smoother (level 1) for the next
-/// linear solve.
-fn damp_smoother(snes: ffi::SNES, damping: f64) -> Result<(), PetscError> {
-    let mut smoother: ffi::KSP = std::ptr::null_mut();
-    // SAFETY: the SNES is live during its callback; PC and smoother are borrowed from it.
-    unsafe {
-        let pc = preconditioner(snes)?;
-        if two_level::is_two_level(pc)? {
-            return two_level::set_damping(pc, damping);
-        }
-        check(
-            ffi::PCMGGetSmoother(pc, 1, &mut smoother),
-            "PCMGGetSmoother",
-        )?;
-        check(
-            ffi::KSPRichardsonSetScale(smoother, damping),
-            "KSPRichardsonSetScale",
-        )
+        Ok(KspRef::lent(ksp))
     }
 }
 
-/// Collective. One vector of the fine level serves as the p-multigrid's residual and as
-/// the full-step line search's trial point, instead of three. The multigrid's residual is
-/// written and read only inside a preconditioner application, the trial point only inside
-/// the line search, which follows the linear solve; the full step never touches its
-/// second vector (the trial residual: it evaluates into the residual itself). Any other
-/// line search keeps its own pair. Measured: two vectors of the fine level fewer at the
-/// memory peak.
-fn share_work_vector(snes: ffi::SNES, x: VecRef<'_>) -> Result<(), PetscError> {
-    let mut ls: ffi::SNESLineSearch = std::ptr::null_mut();
-    // SAFETY: the SNES is live during its callback; its line search is borrowed.
-    let basic = unsafe {
-        check(ffi::SNESGetLineSearch(snes, &mut ls), "SNESGetLineSearch")?;
-        super::has_type(ls as ffi::PetscObject, "basic")?
-    };
-    if !basic {
-        return Ok(());
-    }
-    // Once per set-up: a later solve on the same SNES (a retried or cut increment on the same pattern) finds the line
-    // search's vectors in place.
-    let mut w: ffi::Vec = std::ptr::null_mut();
-    // SAFETY: as above; the vectors are only looked at.
-    unsafe {
-        check(
-            ffi::SNESLineSearchGetVecs(
-                ls,
-                std::ptr::null_mut(),
-                std::ptr::null_mut(),
-                std::ptr::null_mut(),
-                &mut w,
-                std::ptr::null_mut(),
-            ),
-            "SNESLineSearchGetVecs",
-        )?;
-    }
-    if !w.is_null() {
-        return Ok(());
-    }
-    // SAFETY: live SNES; its PC is borrowed from it. The multigrid takes its own reference to
-    // the vector; the line search takes none but destroys both of its vectors on reset, so it
-    // is given one reference for each. Ours goes with `shared`.
-    unsafe {
-        let pc = preconditioner(snes)?;
-        let own_cycle = two_level::is_two_level(pc)?;
-        if !own_cycle {
-            // Level 1 is the fine level only in the two-level hierarchy we build.
-            let mut levels: ffi::PetscInt = 0;
-            check(ffi::PCMGGetLevels(pc, &mut levels), "PCMGGetLevels")?;
-            if levels != 2 {
-                return Ok(());
-            }
+impl<'a> SnesRef<'a> {
+    /// # Safety
+    /// `raw` must be a live SNES for as long as the returned borrow is used.
+    unsafe fn lent(raw: ffi::SNES) -> SnesRef<'a> {
+        SnesRef {
+            raw,
+            _owner: std::marker::PhantomData,
         }
-        let shared = x.duplicate()?;
-        if own_cycle {
-            two_level::set_residual(pc, shared.raw)?;
-        } else {
-            check(ffi::PCMGSetR(pc, 1, shared.raw), "PCMGSetR")?;
-        }
-        for _ in 0..2 {
-            check(
-                ffi::PetscObjectReference(shared.raw as ffi::PetscObject),
-                "PetscObjectReference",
-            )?;
-        }
-        check(
-            ffi::SNESLineSearchSetVecs(
-                ls,
-                std::ptr::null_mut(),
-                std::ptr::null_mut(),
-                std::ptr::null_mut(),
-                shared.raw,
-                shared.raw,
-            ),
-            "SNESLineSearchSetVecs",
-        )
     }
-}
 
-/// Collective. Sets up the p-multigrid's coarse solver (GAMG on the coarse operator the
-/// Jacobian has just assembled) before the Krylov method, the multigrid and its fine smoother
-/// allocate their vectors of the fine level: GAMG's first aggregation of a solve is the memory
-/// peak of the iterative path, and those six vectors need not sit under it. The outer set-up
-/// that follows finds the coarse solver set up for this operator and leaves it.
-fn set_up_coarse_solver(snes: ffi::SNES) -> Result<(), PetscError> {
-    let mut coarse: ffi::KSP = std::ptr::null_mut();
-    // SAFETY: the SNES is live during its callback; PC and coarse KSP are borrowed from it.
-    unsafe {
-        let pc = preconditioner(snes)?;
-        if two_level::is_two_level(pc)? {
-            coarse = two_level::coarse_solver(pc)?;
-        } else {
-            check(
-                ffi::PCMGGetCoarseSolve(pc, &mut coarse),
-                "PCMGGetCoarseSolve",
-            )?;
-        }
-        // Its options are read first, as the multigrid's own set-up would read them.
-        check(ffi::KSPSetFromOptions(coarse), "KSPSetFromOptions(coarse)")?;
-        check(ffi::KSPSetUp(coarse), "KSPSetUp(coarse)")?;
-        // GAMG has aggregated with the rigid-body modes. With its interpolation reused, the
-        // set-ups of the later Newton iterations only redo the Galerkin products and never read
-        // the modes again, so their vectors are freed (three of the coarse level).
-        let mut coarse_pc: ffi::PC = std::ptr::null_mut();
-        check(ffi::KSPGetPC(coarse, &mut coarse_pc), "KSPGetPC(coarse)")?;
-        if super::has_type(coarse_pc as ffi::PetscObject, "gamg")?
-            && bool_option("-mg_coarse_pc_gamg_reuse_interpolation", true)?
-        {
-            check(
-                ffi::MatSetNearNullSpace(two_level::coarse_operator(coarse)?, std::ptr::null_mut()),
-                "MatSetNearNullSpace(coarse, none)",
-            )?;
-        }
-        Ok(())
+    /// The linear solver, borrowed.
+    pub fn ksp(&self) -> Result<KspRef<'a>, PetscError> {
+        // SAFETY: live SNES.
+        unsafe { ksp_of(self.raw) }
     }
-}
 
-/// Tells SNES whether the next linear solve factors the new tangent or keeps the last factors
-/// (see [`FactorReuse`]). SNES reads the preconditioner lag after the Jacobian callback: −2
-/// rebuilds once, −1 keeps. Every rank decides alike: the residual norm and the Krylov count
-/// are global.
-fn choose_factorisation(
-    snes: ffi::SNES,
-    reuse: &FactorReuse,
-    last_norm: &mut Option<f64>,
-) -> Result<(), PetscError> {
-    let mut norm = 0.0;
-    let mut ksp: ffi::KSP = std::ptr::null_mut();
-    let mut its: ffi::PetscInt = 0;
-    let mut reason: ffi::KSPConvergedReason = 0;
-    // SAFETY: live SNES inside its own callback; its KSP is borrowed.
-    unsafe {
+    /// The norm of the residual at the current iterate.
+    pub fn function_norm(&self) -> Result<f64, PetscError> {
+        let mut norm = 0.0;
+        // SAFETY: live SNES.
         check(
-            ffi::SNESGetFunctionNorm(snes, &mut norm),
+            unsafe { ffi::SNESGetFunctionNorm(self.raw, &mut norm) },
             "SNESGetFunctionNorm",
         )?;
-        check(ffi::SNESGetKSP(snes, &mut ksp), "SNESGetKSP")?;
-        check(
-            ffi::KSPGetIterationNumber(ksp, &mut its),
-            "KSPGetIterationNumber",
-        )?;
-        check(
-            ffi::KSPGetConvergedReason(ksp, &mut reason),
-            "KSPGetConvergedReason",
-        )?;
+        Ok(norm)
     }
-    // The first Jacobian of a solve has no last norm: a new increment's tangent is factored.
-    let keep = last_norm.is_some_and(|last| norm <= reuse.contraction * last)
-        && reason > 0
-        && (its.max(0) as usize) <= reuse.max_krylov;
-    *last_norm = Some(norm);
-    // SAFETY: as above.
-    unsafe {
+
+    /// Whether the next linear solve keeps the last preconditioner or builds one from the
+    /// new Jacobian. SNES reads the preconditioner lag after the Jacobian callback: −2
+    /// rebuilds once, −1 keeps.
+    pub fn keep_preconditioner(&self, keep: bool) -> Result<(), PetscError> {
+        // SAFETY: live SNES.
         check(
-            ffi::SNESSetLagPreconditioner(snes, if keep { -1 } else { -2 }),
+            unsafe { ffi::SNESSetLagPreconditioner(self.raw, if keep { -1 } else { -2 }) },
             "SNESSetLagPreconditioner",
         )
+    }
+
+    /// The line search, borrowed.
+    pub fn line_search(&self) -> Result<LineSearchRef<'a>, PetscError> {
+        let mut ls: ffi::SNESLineSearch = std::ptr::null_mut();
+        // SAFETY: live SNES; the line search lives as long as it.
+        check(
+            unsafe { ffi::SNESGetLineSearch(self.raw, &mut ls) },
+            "SNESGetLineSearch",
+        )?;
+        Ok(LineSearchRef {
+            raw: ls,
+            _owner: std::marker::PhantomData,
+        })
+    }
+}
+
+impl LineSearchRef<'_> {
+    /// Whether the line search has its work vectors (the trial point and its residual).
+    pub fn has_work_vectors(&self) -> Result<bool, PetscError> {
+        let mut w: ffi::Vec = std::ptr::null_mut();
+        // SAFETY: live line search; the vector is only looked at.
+        check(
+            unsafe {
+                ffi::SNESLineSearchGetVecs(
+                    self.raw,
+                    std::ptr::null_mut(),
+                    std::ptr::null_mut(),
+                    std::ptr::null_mut(),
+                    &mut w,
+                    std::ptr::null_mut(),
+                )
+            },
+            "SNESLineSearchGetVecs",
+        )?;
+        Ok(!w.is_null())
+    }
+
+    /// Gives the line search its work vectors: the trial point `w` and its residual `g`
+    /// (the same vector may serve both). The line search takes no reference but destroys both
+    /// on reset, so it is given one for each here.
+    pub fn set_work_vectors(&self, w: VecRef<'_>, g: VecRef<'_>) -> Result<(), PetscError> {
+        // SAFETY: live handles; the references taken are the line search's.
+        unsafe {
+            for v in [w, g] {
+                check(
+                    ffi::PetscObjectReference(v.raw as ffi::PetscObject),
+                    "PetscObjectReference",
+                )?;
+            }
+            check(
+                ffi::SNESLineSearchSetVecs(
+                    self.raw,
+                    std::ptr::null_mut(),
+                    std::ptr::null_mut(),
+                    std::ptr::null_mut(),
+                    w.raw,
+                    g.raw,
+                ),
+                "SNESLineSearchSetVecs",
+            )
+        }
     }
 }

@@ -157,3 +157,115 @@ impl VecRef<'_> {
         })
     }
 }
+
+impl VecRef<'_> {
+    /// A reference of our own to this vector, which keeps it alive.
+    pub fn shared(&self) -> Result<PVec, PetscError> {
+        // SAFETY: live vector.
+        check(
+            unsafe { ffi::PetscObjectReference(self.raw as ffi::PetscObject) },
+            "PetscObjectReference",
+        )?;
+        Ok(PVec { raw: self.raw })
+    }
+
+    /// Collective. self = a ∘ b, entry by entry (self may be a or b).
+    pub fn pointwise_mult(&self, a: VecRef<'_>, b: VecRef<'_>) -> Result<(), PetscError> {
+        // SAFETY: live vectors of one layout (PETSc checks).
+        check(
+            unsafe { ffi::VecPointwiseMult(self.raw, a.raw, b.raw) },
+            "VecPointwiseMult",
+        )
+    }
+
+    /// self = alpha self.
+    pub fn scale(&self, alpha: Scalar) -> Result<(), PetscError> {
+        // SAFETY: live vector.
+        check(unsafe { ffi::VecScale(self.raw, alpha) }, "VecScale")
+    }
+
+    /// self = x + alpha self.
+    pub fn aypx(&self, alpha: Scalar, x: VecRef<'_>) -> Result<(), PetscError> {
+        // SAFETY: live vectors of one layout.
+        check(unsafe { ffi::VecAYPX(self.raw, alpha, x.raw) }, "VecAYPX")
+    }
+
+    /// self = self + alpha x.
+    pub fn axpy(&self, alpha: Scalar, x: VecRef<'_>) -> Result<(), PetscError> {
+        // SAFETY: live vectors of one layout.
+        check(unsafe { ffi::VecAXPY(self.raw, alpha, x.raw) }, "VecAXPY")
+    }
+
+    /// Every entry inverted; a zero entry stays zero.
+    pub fn reciprocal(&self) -> Result<(), PetscError> {
+        // SAFETY: live vector.
+        check(unsafe { ffi::VecReciprocal(self.raw) }, "VecReciprocal")
+    }
+
+    /// self = x.
+    pub fn copy_from(&self, x: VecRef<'_>) -> Result<(), PetscError> {
+        // SAFETY: live vectors of one layout.
+        check(unsafe { ffi::VecCopy(x.raw, self.raw) }, "VecCopy")
+    }
+
+    /// Every entry `value`.
+    pub fn set_all(&self, value: Scalar) -> Result<(), PetscError> {
+        // SAFETY: live vector.
+        check(unsafe { ffi::VecSet(self.raw, value) }, "VecSet")
+    }
+
+    /// Collective. Adds `values` at the global entries `indices` (any rank's) and assembles.
+    pub fn add_at(&self, indices: &[Int], values: &[Scalar]) -> Result<(), PetscError> {
+        assert_eq!(indices.len(), values.len(), "one value per index");
+        let n = super::matrix::to_int(indices.len(), "entries")?;
+        // SAFETY: live vector; the arrays are valid for `n` entries and copied.
+        unsafe {
+            check(
+                ffi::VecSetValues(
+                    self.raw,
+                    n,
+                    indices.as_ptr(),
+                    values.as_ptr(),
+                    ffi::InsertMode_ADD_VALUES,
+                ),
+                "VecSetValues",
+            )?;
+            check(ffi::VecAssemblyBegin(self.raw), "VecAssemblyBegin")?;
+            check(ffi::VecAssemblyEnd(self.raw), "VecAssemblyEnd")
+        }
+    }
+
+    /// The global index of this rank's first entry.
+    pub fn first_owned(&self) -> Result<Int, PetscError> {
+        let (mut first, mut end): (Int, Int) = (0, 0);
+        // SAFETY: live vector.
+        check(
+            unsafe { ffi::VecGetOwnershipRange(self.raw, &mut first, &mut end) },
+            "VecGetOwnershipRange",
+        )?;
+        Ok(first)
+    }
+
+    /// Collective. Runs `f` on the entries `is` of this vector, as a vector of their own
+    /// (PETSc's sub-vector, restored after).
+    pub fn with_sub_vector<R>(
+        &self,
+        is: &super::IndexSet,
+        f: impl FnOnce(VecRef<'_>) -> Result<R, PetscError>,
+    ) -> Result<R, PetscError> {
+        let mut sub: ffi::Vec = std::ptr::null_mut();
+        // SAFETY: live handles; the sub-vector lives until restored, after `f`.
+        unsafe {
+            check(
+                ffi::VecGetSubVector(self.raw, is.raw, &mut sub),
+                "VecGetSubVector",
+            )?;
+            let out = f(VecRef::lent(sub));
+            check(
+                ffi::VecRestoreSubVector(self.raw, is.raw, &mut sub),
+                "VecRestoreSubVector",
+            )?;
+            out
+        }
+    }
+}

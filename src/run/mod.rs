@@ -109,6 +109,10 @@ fn drive(
         "step solver: {}",
         step_solver::StepSolver::of(&sim.model, step::MAX_CUTS)
     ));
+    progress.note(&format!(
+        "linear solver: {}",
+        sim.linear_plan(world).map_err(RunError::Petsc)?
+    ));
     let mut last = opts.until_step.unwrap_or(u64::MAX).min(sim.total_steps());
     // The per-rank table after the end-of-run line: sizes of the last mesh, CPU of the solves.
     let mut sizes = None;

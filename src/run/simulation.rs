@@ -42,6 +42,8 @@ pub struct Simulation {
     pub(super) contact_seconds: std::cell::Cell<f64>,
     /// PETSc objects of the last increment (kept while the matrix pattern stays the same).
     pub(super) solver: std::cell::RefCell<Option<super::step::SolverObjects>>,
+    /// The run's linear path, chosen at its first use (`super::step`).
+    pub(super) linear_plan: std::cell::OnceCell<crate::solve::linear_path::LinearPlan>,
     /// The last increment's nodal solution by global node ([gid, gid] for a vertex, the sorted
     /// end ids for a midside node): displacement per whole step and pressure. The next predictor.
     pub(super) last_nodes: std::cell::RefCell<super::node_values::NodeValues>,
@@ -121,6 +123,7 @@ impl Simulation {
             contact_seconds: Default::default(),
             alternate_search: Default::default(),
             solver: Default::default(),
+            linear_plan: Default::default(),
             last_nodes: Default::default(),
             remapped: Default::default(),
             halo: None,

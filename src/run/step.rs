@@ -5,14 +5,12 @@ use super::{Simulation, StepReport};
 use crate::mapping::{recover_at_particles, StartStates, TriStates};
 use crate::material::Rows;
 use crate::mesh::LocalMesh;
-use crate::petsc::linear::{p_multigrid_from_options, upper_triangle_smoother_from_options};
-use crate::petsc::{
-    IndexSet, LinearSolver, Mat, NullSpace, PVec, Petsc, PetscError, Snes, SolveFailure,
-};
-use crate::scene::LinearChoice;
+use crate::petsc::{IndexSet, Mat, NullSpace, PVec, Pc, Petsc, PetscError, Snes, SolveFailure};
 use crate::solve::interpolation::{Interpolation, InterpolationMap};
+use crate::solve::linear_path::{CommandLine, Facts, LinearPath, LinearPlan, Storage};
 use crate::solve::nullspace::orthonormal_rigid_body_modes;
 use crate::solve::pmg::CoarseSpace;
+use crate::solve::precond::{self, Hooked, Hooks, Parts};
 use crate::solve::{
     CoarseOperator, Constraints, DofMap, FieldLayout, SchurPreconditioner, StepProblem, StepSetup,
 };
@@ -24,21 +22,16 @@ pub struct SolverObjects {
     signature: u64,
     x: PVec,
     jac: Mat,
+    /// How the increment's linear systems are solved.
+    path: LinearPath,
     /// The iterative path's extras: the near-null space (attached to `jac` for P2, to the
-    /// displacement field for P2–P1) and the field split of a mixed system.
-    amg: bool,
+    /// displacement field for P2–P1), the field split of a mixed system, the p-multigrid's
+    /// coarse level and the yield zone's preconditioner.
     near_null: Option<NullSpace>,
     split: Option<Split>,
     pmg: Option<PMultigrid>,
-    /// The linear solver asks for the yielded zone at every Jacobian.
-    yield_zone: bool,
+    zone: Option<Pc>,
     snes: Snes,
-}
-
-impl SolverObjects {
-    fn iterative(&self) -> bool {
-        self.amg || self.split.is_some() || self.pmg.is_some()
-    }
 }
 
 /// The coarse level of the two-level p-multigrid (iterative P2 path, `-pfem_pmg`), made with
@@ -59,33 +52,6 @@ struct Split {
     pressure_field: IndexSet,
     pressure_mass: Mat,
 }
-
-/// Global dofs above which `solver.linear = "auto"` solves an elastic P2 system iteratively
-/// (the p-multigrid). A speed crossover, measured on one step of the 50-step cantilever
-/// (bench/VALIDATION.md, 2026-11-25): at 83 k dofs the two paths tie (1.61 against 1.56 s on 1
-/// rank, 1.19 against 1.16 s on 2), at 186 k the p-multigrid leads (3.3–3.5 against 3.9–4.1 s,
-/// 2.1–2.3 against 3.3–3.5 s) with less than half the memory, and at 333 k and 1.3 M dofs it
-/// leads on the large increments of the 5-step cantilever too (23.8–26.8 against 35.6 s and
-/// 101 against 158 s, 2 ranks).
-const ITERATIVE_ABOVE_DOFS: usize = 150_000;
-/// Whether `solver.linear = "auto"` solves iteratively: elastic P2 systems past
-/// [`ITERATIVE_ABOVE_DOFS`].
-fn auto_is_iterative(vertex_dofs: usize, plastic: bool, n_global_dofs: usize) -> bool {
-    vertex_dofs == 2 && !plastic && n_global_dofs > ITERATIVE_ABOVE_DOFS
-}
-
-/// Global dofs past which GAMG forms its Galerkin products all at once on several ranks
-/// (`prefer_lean_galerkin_products`): where memory, not time, bounds the run.
-const LEAN_PRODUCTS_ABOVE_DOFS: usize = 2_000_000;
-/// Relative tolerances of the iterative linear solves: tight enough that Newton's iterates, and
-/// so the histories, match the direct solver's (tests/iterative.rs: 1e-11 relative or closer).
-/// GMRES+GAMG on the cantilever (h = 1/8, 5 steps): 1e-6 kept the direct path's 35 Newton
-/// iterations with 1082 Krylov iterations against 1342 at 1e-8. The field split at 1e-6 added
-/// Newton iterations on the ν = 0.4999 block (10 instead of 8 at h = 0.1 and 0.05, 13 instead of
-/// 10 at h = 0.025) and so about as many Krylov iterations as 1e-8 (320 vs 332, 343 vs 367, 476
-/// vs 494), so it solves to 1e-8.
-const AMG_RTOL: f64 = 1e-6;
-const SCHUR_RTOL: f64 = 1e-8;
 
 /// FNV-1a over the global dof numbers of every local triangle: equal signatures mean the same
 /// matrix pattern on this rank.
@@ -337,7 +303,7 @@ impl Simulation {
         // where a factorisation's symbolic phase is reused. An iterative solver sets up afresh
         // anyway, and its matrices would sit under the peak of the mapping, output and
         // checkpoint that follow (cantilever h = 1/128, 1 rank: 1 466 → 1 194 MB).
-        if !cache.iterative() {
+        if !cache.path.iterative() {
             *self.solver.borrow_mut() = Some(cache);
         }
         outcome.map(|o| Solved {
@@ -383,31 +349,18 @@ impl Simulation {
         let solver = &self.model.scene.solver;
         let line_search =
             super::step_solver::StepSolver::of(&self.model, MAX_CUTS).line_search(alternate);
-        let iterative = match solver.linear {
-            LinearChoice::Direct => false,
-            LinearChoice::Iterative => true,
-            // Plastic scenes are left to an explicit choice: at yield the iterative paths solve
-            // the yielded zone exactly (GAMG alone does not converge there, on the field
-            // split's displacement block or on a P2 system), so they cost a direct solve of
-            // the zone on top of the iterations: 2–3 times the direct path's time on
-            // footing-shallow at 1.8 k–28 k particles (bench/VALIDATION.md, "The field split
-            // at yield, solved").
-            LinearChoice::Auto => {
-                auto_is_iterative(dofs.vertex_dofs, self.model.plastic(), dofs.n_global_dofs)
-            }
+        let path = self.linear_plan(world)?.path(dofs.n_global_dofs);
+        let split = match path {
+            LinearPath::FieldSplit { .. } => Some(self.field_split(world, mesh, dofs)?),
+            _ => None,
         };
-        let split = if iterative && dofs.vertex_dofs == 3 {
-            Some(self.field_split(world, mesh, dofs)?)
-        } else {
-            None
-        };
-        if iterative && world.size() > 1 && dofs.n_global_dofs > LEAN_PRODUCTS_ABOVE_DOFS {
-            crate::petsc::linear::prefer_lean_galerkin_products()?;
+        if path.lean_galerkin_products(world.size() as usize, dofs.n_global_dofs) {
+            // A process option, read when a solver is set up: once a run has set it, it keeps
+            // it, and the command line wins.
+            crate::petsc::options::set_default("-matptap_via", "allatonce")?;
         }
-        // A yielded P2 tangent needs the yield zone ([`LinearSolver::Amg`]), which wraps GAMG.
-        let pmg =
-            if iterative && split.is_none() && !self.model.plastic() && p_multigrid_from_options()?
-            {
+        let pmg = match path {
+            LinearPath::PMultigrid { .. } => {
                 let space = CoarseSpace::build(world, mesh, dofs).map_err(|e| PetscError {
                     code: -1,
                     message: e.to_string(),
@@ -430,52 +383,36 @@ impl Simulation {
                     interpolation,
                     coarse,
                 })
-            } else {
-                None
-            };
+            }
+            _ => None,
+        };
         // The p-multigrid only multiplies by the P2 tangent and reads its diagonal: blocks,
         // and only the upper triangle of a symmetric one.
-        let jac =
-            if pmg.is_some() && self.symmetric_tangent() && upper_triangle_smoother_from_options()?
-            {
+        let jac = match path.storage() {
+            Storage::UpperBlocks => {
                 let (d_blocks, o_blocks) = dofs.upper_block_preallocation();
                 Mat::sbaij(world, dofs.n_owned_dofs, &d_blocks, &o_blocks)?
-            } else if pmg.is_some() {
+            }
+            Storage::Blocks => {
                 let (d_nnz, o_nnz) = dofs.preallocation();
                 Mat::baij(world, dofs.n_owned_dofs, 2, &d_nnz, &o_nnz)?
-            } else {
+            }
+            Storage::Aij => {
                 let (d_nnz, o_nnz) = dofs.preallocation();
                 Mat::aij(world, dofs.n_owned_dofs, dofs.block_size(), &d_nnz, &o_nnz)?
-            };
-        let yield_zone = iterative
-            && self.model.plastic()
-            && crate::petsc::linear::yield_zone_from_options(split.is_some())?;
-        let linear = match &split {
-            Some(s) => LinearSolver::Schur {
-                rtol: SCHUR_RTOL,
-                yield_zone,
+            }
+        };
+        let parts = match (&split, &pmg) {
+            (Some(s), _) => Parts::FieldSplit {
                 displacement: &s.displacement_field,
                 pressure: &s.pressure_field,
                 pressure_mass: &s.pressure_mass,
             },
-            None if pmg.is_some() => {
-                let m = pmg.as_ref().expect("checked");
-                LinearSolver::PMultigrid {
-                    rtol: AMG_RTOL,
-                    symmetric: self.symmetric_tangent(),
-                    interpolation: &m.interpolation,
-                    coarse: &m.coarse,
-                }
-            }
-            None if iterative => LinearSolver::Amg {
-                rtol: AMG_RTOL,
-                symmetric: self.symmetric_tangent(),
-                yield_zone,
+            (None, Some(m)) => Parts::PMultigrid {
+                interpolation: &m.interpolation,
+                coarse: &m.coarse,
             },
-            None => LinearSolver::Direct {
-                reuse: crate::petsc::FactorReuse::from_options(solver.reuse_factorisation)?,
-                symmetric: self.symmetric_tangent(),
-            },
+            (None, None) => Parts::None,
         };
         // A residual at round-off of the body's force scale (E h, N/m) is converged: a step
         // with no load at all (a body released from its platen) has no first residual for the
@@ -487,20 +424,46 @@ impl Simulation {
             abstol,
             solver.newton_rtol,
             solver.newton_max_it as usize,
-            line_search,
-            &linear,
         )?;
+        let zone = precond::configure(snes.ksp()?, &path, parts)?;
+        snes.set_lag_preconditioner(path.preconditioner_lag())?;
+        if let Some(cap) = path.inexact_newton_cap() {
+            snes.use_eisenstat_walker(cap)?;
+        }
+        snes.set_line_search(line_search)?;
+        snes.set_from_options()?;
         Ok(SolverObjects {
             signature,
             x,
             jac,
-            amg: iterative && split.is_none() && pmg.is_none(),
+            path,
             near_null: None,
             split,
             pmg,
-            yield_zone,
+            zone,
             snes,
         })
+    }
+
+    /// Collective. The run's linear path, chosen at the first call from the model and the
+    /// command line ([`LinearPlan::choose`]).
+    pub(super) fn linear_plan(&self, world: &Comm) -> Result<&LinearPlan, PetscError> {
+        if let Some(plan) = self.linear_plan.get() {
+            return Ok(plan);
+        }
+        let solver = &self.model.scene.solver;
+        let facts = Facts {
+            mixed: self.model.mixed(),
+            plastic: self.model.plastic(),
+            symmetric: self.symmetric_tangent(),
+            scene: solver.linear,
+        };
+        let cl = CommandLine::read(world, solver.linear, solver.reuse_factorisation)?;
+        let plan = LinearPlan::choose(&facts, &cl).map_err(|message| PetscError {
+            code: crate::petsc::error::PETSC_ERR_USER,
+            message,
+        })?;
+        Ok(self.linear_plan.get_or_init(|| plan))
     }
 
     /// Whether every tangent of the scene is symmetric: an elastic P2 solid (the material and
@@ -565,23 +528,23 @@ impl Simulation {
         step: u64,
     ) -> Result<Outcome, SolveError> {
         let err = |e: String| SolveError::Fatal(e);
-        let iterative = objects.iterative();
         let SolverObjects {
             x,
             jac,
             snes,
-            amg,
+            path,
             near_null,
             split,
             pmg,
-            yield_zone,
+            zone,
             ..
         } = objects;
+        let iterative = path.iterative();
         let mut problem =
             StepProblem::new(world, mesh, dofs, setup, x).map_err(|e| err(e.to_string()))?;
         if iterative {
             problem = problem.without_element_cache();
-            if *yield_zone {
+            if path.yield_zone() {
                 problem = problem.with_yielded_zone();
             }
         }
@@ -590,7 +553,7 @@ impl Simulation {
                 matrix: &m.coarse,
                 space: &m.space,
             });
-            if snes.damps_smoother() {
+            if path.damps_smoother() {
                 problem = problem.with_jacobi_bound();
             }
         }
@@ -599,7 +562,7 @@ impl Simulation {
                 matrix: &split.pressure_mass,
                 pressure_index: &split.layout.pressure_index,
             });
-        } else if *amg {
+        } else if path.near_null_space_on_tangent() {
             // The modes at this increment's start: the nodes moved since the matrix was made.
             let modes = orthonormal_rigid_body_modes(world, &dofs.owned_coordinates(&mesh.points));
             let space = NullSpace::new(world, dofs.n_owned_dofs, &modes)
@@ -647,8 +610,13 @@ impl Simulation {
         problem
             .initial_guess(x, displacement, vertex_pressure)
             .map_err(|e| err(e.to_string()))?;
+        let zone = zone.as_ref().map(Pc::as_ref);
         let mut newton = |problem: &mut StepProblem, x: &mut PVec, jac: &mut Mat| {
-            snes.solve(problem, x, jac).map_err(|e| match e {
+            let mut hooked = Hooked {
+                problem,
+                hooks: Hooks::new(*path, zone),
+            };
+            snes.solve(&mut hooked, x, jac).map_err(|e| match e {
                 SolveFailure::Diverged(d) => SolveError::Diverged(format!("step {step}: {d}")),
                 SolveFailure::Failed(e) => SolveError::Fatal(format!("step {step}: {}", e.message)),
             })
@@ -658,7 +626,7 @@ impl Simulation {
         // An iterative solver is not kept for the next increment (see `solve`): its hierarchy
         // and vectors are freed now, before the converged state's element pass.
         if iterative {
-            snes.reset().map_err(|e| err(e.to_string()))?;
+            precond::hooks::reset(snes, zone).map_err(|e| err(e.to_string()))?;
             // Returned to the system, or the converged pass's new states (216 bytes a
             // triangle) would be placed beside the freed pages and raise the peak RSS (1.03 M
             // particles, 2 ranks: by 120–180 MB a rank).
@@ -1025,18 +993,4 @@ fn owned_area(mesh: &LocalMesh, du: &[[f64; 2]], dofs: &DofMap) -> f64 {
         area += 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
     }
     area
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn auto_is_iterative_for_large_elastic_p2_systems_only() {
-        assert!(auto_is_iterative(2, false, 186_434));
-        assert!(!auto_is_iterative(2, false, 83_330));
-        // A yielded P2 tangent defeats the p-multigrid; P2–P1 defeats the field split.
-        assert!(!auto_is_iterative(2, true, 8_000_000));
-        assert!(!auto_is_iterative(3, false, 8_000_000));
-    }
 }

@@ -4,9 +4,11 @@
 pub mod constraints;
 pub mod dofs;
 pub mod interpolation;
+pub mod linear_path;
 pub mod material_pressures;
 pub mod nullspace;
 pub mod pmg;
+pub mod precond;
 pub mod problem;
 pub mod smoother;
 pub mod split;

@@ -255,7 +255,7 @@ impl<'a> StepProblem<'a> {
     }
 
     /// Every Jacobian lists the displacement dofs of the owned triangles that yield at its
-    /// iterate ([`NonlinearProblem::yielded_dofs`]): a Gauss point whose equivalent plastic
+    /// iterate ([`super::precond::JacobianProducts::yielded_dofs`]): a Gauss point whose equivalent plastic
     /// strain grows there has the plastic tangent, with no stiffness along its flow direction.
     pub fn with_yielded_zone(mut self) -> Self {
         self.yielded = Some(RefCell::new(Vec::new()));
@@ -269,7 +269,7 @@ impl<'a> StepProblem<'a> {
     }
 
     /// Every Jacobian bounds the spectrum of diag(J)⁻¹J for the p-multigrid's smoother
-    /// ([`NonlinearProblem::smoother_damping`]). Every rank must agree, and the tangent must be
+    /// ([`super::precond::JacobianProducts::smoother_damping`]). Every rank must agree, and the tangent must be
     /// the sum of symmetric element tangents alone: contact and follower pressures add terms
     /// that are neither.
     pub fn with_jacobi_bound(mut self) -> Self {
@@ -878,20 +878,6 @@ impl NonlinearProblem for StepProblem<'_> {
         Ok(())
     }
 
-    fn yielded_dofs(&mut self) -> Vec<usize> {
-        self.yielded
-            .as_ref()
-            .map(|y| std::mem::take(&mut *y.borrow_mut()))
-            .unwrap_or_default()
-    }
-
-    fn smoother_damping(&self) -> Option<f64> {
-        self.jacobi_bound
-            .get()
-            .filter(|b| b.is_finite())
-            .map(jacobi_damping)
-    }
-
     fn jacobian(&mut self, x: VecRef<'_>, j: MatRef<'_>) -> Result<(), CallbackError> {
         let fatal = |e: PetscError| CallbackError::Fatal(e.to_string());
         j.zero_entries().map_err(fatal)?;
@@ -1058,6 +1044,22 @@ impl NonlinearProblem for StepProblem<'_> {
                 .map_err(fatal)?;
         }
         j.assemble().map_err(fatal)
+    }
+}
+
+impl super::precond::JacobianProducts for StepProblem<'_> {
+    fn yielded_dofs(&mut self) -> Vec<usize> {
+        self.yielded
+            .as_ref()
+            .map(|y| std::mem::take(&mut *y.borrow_mut()))
+            .unwrap_or_default()
+    }
+
+    fn smoother_damping(&self) -> Option<f64> {
+        self.jacobi_bound
+            .get()
+            .filter(|b| b.is_finite())
+            .map(jacobi_damping)
     }
 }
 
