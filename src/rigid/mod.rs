@@ -30,7 +30,24 @@ pub fn crosses(shape: &Shape, tri: [[f64; 2]; 3], h: f64) -> bool {
     }
     // The inradius (a search over the core's edges) only when the spacing alone does not decide.
     let depth = shape.triangle_depth(tri);
-    depth > CROSSING_DEPTH * h || depth > 0.0 && depth > CROSSING_DEPTH * shape.inradius()
+    if depth > CROSSING_DEPTH * h || depth > 0.0 && depth > CROSSING_DEPTH * shape.inradius() {
+        return true;
+    }
+    // Across an obtuse corner (a cone's shoulder, 150°) the triangle of the corner particle
+    // and its two neighbours on the faces lies inside the body yet reaches only a quarter of
+    // its side in; its centroid is inside, where no soil triangle's is.
+    depth > 0.0 && shape.closest(centroid(tri)).distance < -CENTROID_DEPTH * h
+}
+
+/// A triangle whose centroid lies deeper than this fraction of its spacing inside a rigid body
+/// crosses it.
+pub const CENTROID_DEPTH: f64 = 0.02;
+
+fn centroid(t: [[f64; 2]; 3]) -> [f64; 2] {
+    [
+        (t[0][0] + t[1][0] + t[2][0]) / 3.0,
+        (t[0][1] + t[1][1] + t[2][1]) / 3.0,
+    ]
 }
 
 #[cfg(test)]
@@ -127,5 +144,27 @@ mod tests {
             [[0.2, 0.5], [0.8, 0.49], [0.8, 0.51]],
             0.05
         ));
+    }
+
+    #[test]
+    fn the_triangle_inside_an_obtuse_corner_crosses_it() {
+        // A cone's shoulder: a face 30° off the vertical meeting a vertical shaft, sharp. The
+        // particle at the corner and one on each face a spacing away span a triangle inside
+        // the body that reaches only 0.25 h in; its centroid is 0.17 h in.
+        let h = 0.01;
+        let (s, c) = 30f64.to_radians().sin_cos();
+        let cone = Shape::polygon(&[[0.0, 0.0], [1.0, c / s], [1.0, 3.0], [-1.0, 3.0], [-1.0, c / s]], 0.0)
+            .unwrap();
+        let corner = [1.0, c / s];
+        let on_face = [corner[0] - h * s, corner[1] - h * c];
+        let on_shaft = [1.0, corner[1] + h];
+        let tri = [on_face, corner, on_shaft];
+        let depth = cone.triangle_depth(tri);
+        assert!(depth > 0.2 * h && depth < CROSSING_DEPTH * h, "depth {depth}");
+        assert!(crosses(&cone, tri, h));
+        // The soil's triangle on the other side of the same two edges stays.
+        let out = [1.0 + 0.8 * h, corner[1]];
+        assert!(!crosses(&cone, [on_face, out, corner], h));
+        assert!(!crosses(&cone, [corner, out, on_shaft], h));
     }
 }
