@@ -187,7 +187,11 @@ mod tests {
         assert_eq!(p.position[0], [0.0, 1.0]);
         assert_eq!(p.position[1], [0.06, 2.0], "0.12 h off the axis stays");
         assert_eq!(p.position[2], [0.0, 3.0]);
-        assert_eq!(p.position[3], [0.0, 4.0], "a particle past the axis comes back onto it");
+        assert_eq!(
+            p.position[3],
+            [0.0, 4.0],
+            "a particle past the axis comes back onto it"
+        );
         assert_eq!(p.increment[0], [0.0, 0.1]);
         assert_eq!(p.increment[1], [-0.01, 0.1]);
         for (i, r) in reference.iter().enumerate() {

@@ -238,7 +238,10 @@ fn newton_iterations(log: &str) -> usize {
         .lines()
         .find(|l| l.starts_with("done:"))
         .expect("a done: line");
-    let before = done.split(" Newton iterations").next().expect("Newton iterations");
+    let before = done
+        .split(" Newton iterations")
+        .next()
+        .expect("Newton iterations");
     before
         .rsplit(' ')
         .next()

@@ -153,14 +153,26 @@ mod tests {
         // the body that reaches only 0.25 h in; its centroid is 0.17 h in.
         let h = 0.01;
         let (s, c) = 30f64.to_radians().sin_cos();
-        let cone = Shape::polygon(&[[0.0, 0.0], [1.0, c / s], [1.0, 3.0], [-1.0, 3.0], [-1.0, c / s]], 0.0)
-            .unwrap();
+        let cone = Shape::polygon(
+            &[
+                [0.0, 0.0],
+                [1.0, c / s],
+                [1.0, 3.0],
+                [-1.0, 3.0],
+                [-1.0, c / s],
+            ],
+            0.0,
+        )
+        .unwrap();
         let corner = [1.0, c / s];
         let on_face = [corner[0] - h * s, corner[1] - h * c];
         let on_shaft = [1.0, corner[1] + h];
         let tri = [on_face, corner, on_shaft];
         let depth = cone.triangle_depth(tri);
-        assert!(depth > 0.2 * h && depth < CROSSING_DEPTH * h, "depth {depth}");
+        assert!(
+            depth > 0.2 * h && depth < CROSSING_DEPTH * h,
+            "depth {depth}"
+        );
         assert!(crosses(&cone, tri, h));
         // The soil's triangle on the other side of the same two edges stays.
         let out = [1.0 + 0.8 * h, corner[1]];
