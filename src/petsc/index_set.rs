@@ -19,27 +19,13 @@ impl IndexSet {
         indices: &[Int],
         block: usize,
     ) -> Result<IndexSet, PetscError> {
-        let mut raw: ffi::IS = std::ptr::null_mut();
-        // SAFETY: the index array is valid for its length and copied (PETSC_COPY_VALUES); the
-        // handle is owned by the returned value from the first successful call on.
-        unsafe {
-            check(
-                ffi::ISCreateGeneral(
-                    comm.as_raw(),
-                    to_int(indices.len(), "index set")?,
-                    indices.as_ptr(),
-                    ffi::PetscCopyMode_PETSC_COPY_VALUES,
-                    &mut raw,
-                ),
-                "ISCreateGeneral",
-            )?;
-            let is = IndexSet { raw };
-            check(
-                ffi::ISSetBlockSize(raw, to_int(block, "block size")?),
-                "ISSetBlockSize",
-            )?;
-            Ok(is)
-        }
+        let is = IndexSet::create(comm.as_raw(), indices)?;
+        // SAFETY: a live index set of ours.
+        check(
+            unsafe { ffi::ISSetBlockSize(is.raw, to_int(block, "block size")?) },
+            "ISSetBlockSize",
+        )?;
+        Ok(is)
     }
 
     /// Collective. This rank's `indices` (copied), on the communicator of `like`.
@@ -47,9 +33,14 @@ impl IndexSet {
         like: &impl super::object::Object,
         indices: &[Int],
     ) -> Result<IndexSet, PetscError> {
-        let comm = super::object::comm_of(like)?;
+        IndexSet::create(super::object::comm_of(like)?, indices)
+    }
+
+    /// Collective on `comm`. This rank's `indices`, copied.
+    fn create(comm: ffi::MPI_Comm, indices: &[Int]) -> Result<IndexSet, PetscError> {
         let mut raw: ffi::IS = std::ptr::null_mut();
-        // SAFETY: the index array is valid for its length and copied.
+        // SAFETY: the index array is valid for its length and copied (PETSC_COPY_VALUES); the
+        // handle is owned by the returned value.
         check(
             unsafe {
                 ffi::ISCreateGeneral(
