@@ -206,6 +206,13 @@ impl Simulation {
             retain(&mut p.material, &keep);
         }
         p.sort_by_gid();
+        // Every rank forgets the triangles around every moved particle, its ghosts' too: a
+        // rank that kept its copy of an interface triangle whose far vertex its owner moved
+        // would start the next step from Gauss states the owner had replaced, and the copies
+        // of one triangle would differ between ranks from then on (and so would recovery,
+        // checkpoints and the answer on another rank count).
+        let mine: Vec<u64> = moved.into_iter().collect();
+        let moved: HashSet<u64> = allgather_u64(world, &mine).into_iter().collect();
         self.tri_states.forget_touching(&moved);
         Ok(true)
     }
