@@ -75,9 +75,9 @@ fn rough_tbar_same_curve_on_one_two_three_ranks() {
         assert!(newton <= 4 * 15, "{newton} Newton iterations");
     }
     println!("Nc: {:?}", column(&dir, "r1", "Nc"));
-    // Measured: 1 and 2 ranks agree to 1e-15; 3 ranks took 49 iterations and differ by
-    // 2.4e-6 at step 2 (the issue asks for 0.5 %).
-    same_histories(&dir, &outs, 1e-5);
+    // Measured: 1, 2 and 3 ranks agree to 5e-15 (3 ranks differed by 2.4e-6 at step 2 while
+    // ranks kept their own copies of triangles around a particle another rank smoothed).
+    same_histories(&dir, &outs, 1e-9);
 }
 
 #[test]

@@ -72,7 +72,9 @@ fn footing_coarse_is_within_15_percent_of_prandtl_and_below_the_deep_limit() {
         "q/cu {} at z/B = 0.2",
         q[19]
     );
-    close(&q, &column(&dir, &r2, "q_over_cu"), 1e-3);
+    // Measured: 1 and 2 ranks within 5e-15 (0.4 % apart at step 13 while ranks kept their
+    // own copies of triangles around a particle another rank smoothed).
+    close(&q, &column(&dir, &r2, "q_over_cu"), 1e-9);
 }
 
 fn tbar(name: &str, exact: f64) {
