@@ -90,3 +90,37 @@ fn a_step_that_cannot_converge_stops_all_ranks_with_the_reason() {
     );
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
+
+/// A solver option that names no path (or one the scene cannot take) is a usage error on every
+/// rank, in its own words, before an output folder is made.
+#[test]
+fn a_bad_linear_solver_option_is_a_usage_error_and_leaves_no_output() {
+    let dir = workdir("bad-linear-solver");
+    let mixed = "solver.element=\"p2p1\"";
+    ok(
+        &dir,
+        1,
+        &["new", "cantilever", "-o", "c.h5", "--set", mixed],
+    );
+    for ranks in [1, 2] {
+        for (value, needle) in [
+            ("bogus", "choose one of auto, direct"),
+            ("pmg", "the p-multigrid solves P2 systems"),
+        ] {
+            let args = ["c.h5", "--out", "o", "--", "-pfem_linear_solver", value];
+            let out = run(&dir, ranks, &args);
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(
+                out.status.code(),
+                Some(2),
+                "{ranks} ranks, {value}:\n{stderr}"
+            );
+            assert!(stderr.contains(needle), "{value}: {stderr}");
+            assert!(!stderr.contains("PETSc error"), "{value}: {stderr}");
+            assert!(
+                !dir.join("o").exists(),
+                "{value}: an output folder was made"
+            );
+        }
+    }
+}

@@ -108,6 +108,17 @@ pub enum RunError {
 }
 
 impl RunError {
+    /// An error of choosing the linear path: a command-line option or scene setting that does
+    /// not name a path, or names one the scene cannot take, is a usage error in its own words;
+    /// a failure of PETSc itself stays one.
+    pub fn solver_option(e: PetscError) -> RunError {
+        if e.code == crate::petsc::error::PETSC_ERR_USER {
+            RunError::Usage(e.message)
+        } else {
+            RunError::Petsc(e)
+        }
+    }
+
     /// The process exit code: 2 for a command line that could not be parsed, 1 for the rest.
     pub fn exit_code(&self) -> i32 {
         match self {

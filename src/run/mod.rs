@@ -103,16 +103,18 @@ fn drive(
     fault("load", 0)?;
     let sim = held.insert(Simulation::load(world, &opts.case)?);
     sanity::check_until_step(opts, sim)?;
+    // Chosen before the output folder is made: a bad solver option leaves no empty run behind.
+    let linear = sim
+        .linear_plan(world)
+        .map_err(RunError::solver_option)?
+        .to_string();
     let mut out = output::Output::open(world, sim, &opts.out_dir)?;
     let progress = progress.insert(Progress::new(world, sim, opts)?);
     progress.note(&format!(
         "step solver: {}",
         step_solver::StepSolver::of(&sim.model, step::MAX_CUTS)
     ));
-    progress.note(&format!(
-        "linear solver: {}",
-        sim.linear_plan(world).map_err(RunError::Petsc)?
-    ));
+    progress.note(&format!("linear solver: {linear}"));
     let mut last = opts.until_step.unwrap_or(u64::MAX).min(sim.total_steps());
     // The per-rank table after the end-of-run line: sizes of the last mesh, CPU of the solves.
     let mut sizes = None;
