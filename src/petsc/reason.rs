@@ -130,6 +130,8 @@ pub enum Divergence {
         reason: SnesDiverged,
         linear: Option<KspDiverged>,
         iterations: usize,
+        /// Krylov iterations over the solve.
+        linear_iterations: usize,
         residual: f64,
         /// Why the problem refused a trial state, for a domain error (a material's message).
         domain: Option<String>,
@@ -140,8 +142,27 @@ pub enum Divergence {
         lambda: f64,
         step_tol: f64,
         iterations: usize,
+        linear_iterations: usize,
         residual: f64,
     },
+}
+
+impl Divergence {
+    /// The Newton and Krylov iterations the failed solve spent.
+    pub fn spent(&self) -> [usize; 2] {
+        match self {
+            Divergence::Snes {
+                iterations,
+                linear_iterations,
+                ..
+            }
+            | Divergence::Stalled {
+                iterations,
+                linear_iterations,
+                ..
+            } => [*iterations, *linear_iterations],
+        }
+    }
 }
 
 impl fmt::Display for Divergence {
@@ -153,6 +174,7 @@ impl fmt::Display for Divergence {
                 iterations,
                 residual,
                 domain,
+                ..
             } => {
                 write!(f, "Newton did not converge ({reason}")?;
                 if let Some(l) = linear {
@@ -171,6 +193,7 @@ impl fmt::Display for Divergence {
                 step_tol,
                 iterations,
                 residual,
+                ..
             } => write!(
                 f,
                 "Newton stalled (update below {step_tol:e} of the solution after a step damped \

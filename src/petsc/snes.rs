@@ -258,11 +258,13 @@ impl Snes {
             // Newton step; a strongly damped step is tiny because Newton is stuck, whatever the
             // residual.
             let (iterations, residual) = (its.max(0) as usize, norm);
+            let linear_iterations = lits.max(0) as usize;
             if lambda < 0.5 {
                 return Err(SolveFailure::Diverged(Divergence::Stalled {
                     lambda,
                     step_tol: STEP_TOL,
                     iterations,
+                    linear_iterations,
                     residual,
                 }));
             }
@@ -286,6 +288,7 @@ impl Snes {
                     reason,
                     linear,
                     iterations,
+                    linear_iterations,
                     residual,
                     domain,
                 }));

@@ -40,6 +40,10 @@ pub struct Simulation {
     pub(super) alternate_search: std::cell::Cell<bool>,
     /// Seconds spent on contact since the last step report.
     pub(super) contact_seconds: std::cell::Cell<f64>,
+    /// Newton and Krylov iterations of the tries that failed since the last step report (a
+    /// diverged or unsettled piece costs as much as a converged one: the reported counts are
+    /// the work done).
+    pub(super) failed_tries: std::cell::Cell<[usize; 2]>,
     /// PETSc objects of the last increment (kept while the matrix pattern stays the same).
     pub(super) solver: std::cell::RefCell<Option<super::step::SolverObjects>>,
     /// The run's linear path, chosen at its first use (`super::step`).
@@ -121,6 +125,7 @@ impl Simulation {
             last_contact: Default::default(),
             contact_switches: Default::default(),
             contact_seconds: Default::default(),
+            failed_tries: Default::default(),
             alternate_search: Default::default(),
             solver: Default::default(),
             linear_plan: Default::default(),

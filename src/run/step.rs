@@ -617,7 +617,10 @@ impl Simulation {
                 hooks: Hooks::new(*path, zone),
             };
             snes.solve(&mut hooked, x, jac).map_err(|e| match e {
-                SolveFailure::Diverged(d) => SolveError::Diverged(format!("step {step}: {d}")),
+                SolveFailure::Diverged(d) => {
+                    self.count_failed_try(d.spent());
+                    SolveError::Diverged(format!("step {step}: {d}"))
+                }
                 SolveFailure::Failed(e) => SolveError::Fatal(format!("step {step}: {}", e.message)),
             })
         };
@@ -651,7 +654,10 @@ impl Simulation {
         let reaction = problem.reaction(&converged, driven);
         let set_reactions = self.set_reactions(mesh, dofs, &problem, &converged, from);
         let laws = problem.contact_laws(&local);
-        self.check_contact_gaps(world, problem.contact_pairs(), &laws, spacing, step)?;
+        self.check_contact_gaps(world, problem.contact_pairs(), &laws, spacing, step)
+            .inspect_err(|_| {
+                self.count_failed_try([stats.newton_iterations, stats.linear_iterations])
+            })?;
         let mut body_force = vec![[0.0; 2]; self.model.bodies.len()];
         let mut contact_state = super::contact::ContactState::new();
         for (c, law) in problem.contact_pairs().iter().zip(&laws) {
@@ -883,8 +889,9 @@ impl Simulation {
                     remapped += report.remapped;
                     converged_pieces = true;
                     if completes {
-                        report.newton_iterations = newton;
-                        report.linear_iterations = linear;
+                        let [failed_newton, failed_linear] = self.failed_tries.take();
+                        report.newton_iterations = newton + failed_newton;
+                        report.linear_iterations = linear + failed_linear;
                         report.remapped = remapped;
                         report.contact_switches = self.contact_switches.take() as usize;
                         report.contact_seconds = self.contact_seconds.take();
@@ -950,6 +957,12 @@ impl Simulation {
         }
     }
 
+    /// Adds a failed try's Newton and Krylov iterations to the step's report.
+    fn count_failed_try(&self, [newton, linear]: [usize; 2]) {
+        let [n, l] = self.failed_tries.get();
+        self.failed_tries.set([n + newton, l + linear]);
+    }
+
     /// Collective. The report of a step in which the collapse was bracketed in `[held, failed]`:
     /// equilibrium held at `held` (the body is there now) and failed, or was a mechanism, by
     /// `failed`. Pieces of the step that converged make a (shorter) step whose row is the
@@ -965,9 +978,10 @@ impl Simulation {
         if converged_pieces {
             self.header.step += 1;
         }
+        let [failed_newton, failed_linear] = self.failed_tries.take();
         StepReport {
-            newton_iterations: counts[0],
-            linear_iterations: counts[1],
+            newton_iterations: counts[0] + failed_newton,
+            linear_iterations: counts[1] + failed_linear,
             cuts: counts[2],
             remapped: counts[3] as u64,
             contact_switches: self.contact_switches.take() as usize,
