@@ -155,9 +155,13 @@ pub fn plan(
             // the smaller id, and whose neighbours stay closer than the split length: the
             // boundary edge that replaces its two is neither split again nor a shortcut across
             // a corner.
+            // A neighbour held on a symmetry plane near a body cannot give way, so a particle
+            // sliding into it goes whatever the ids: at a stagnation point on the plane (the
+            // top of a T-bar, where the soil closes behind it) the pair would otherwise close
+            // to a sliver that Newton's iterates invert.
             if let [a, c] = along[p][..] {
                 let close = [a, c].iter().any(|&q| {
-                    mesh.gids[q as usize] < mesh.gids[p]
+                    (mesh.gids[q as usize] < mesh.gids[p] || support_gap(q as usize).is_some())
                         && dist(pu, q) < params.merge_distance * spacing(pu, q)
                 });
                 if close && slides(p) && dist(a, c) < params.split_length * spacing(a, c) {
@@ -382,6 +386,28 @@ mod tests {
         // Without particle 3 closing in, removing 2 would leave an edge to split at once.
         let gap = lattice_with(2, [-0.7, 0.0]);
         assert!(plan(&gap, |_| false, |_| true, |_| None, &params)
+            .remove
+            .is_empty());
+    }
+
+    #[test]
+    fn a_particle_sliding_into_one_held_on_a_symmetry_plane_goes_whatever_the_ids() {
+        // Bottom row: 3 has slid to 0.3 from 4, held on the plane x = 4 where it meets a body
+        // (the stagnation point on a T-bar's top); 2 follows, closing the gap 3 would leave.
+        let m = lattice(5, 5, 1.0, |i| match i {
+            3 => [0.7, 0.0],
+            2 => [0.5, 0.0],
+            _ => [0.0, 0.0],
+        });
+        let on_plane = |p: usize| m.points[p][0] == 4.0;
+        let params = RefineParams::default();
+        let near_body = |p: usize| on_plane(p).then_some(0.0);
+        assert_eq!(
+            plan(&m, on_plane, |_| true, near_body, &params).remove,
+            vec![3]
+        );
+        // Held but with no body near, the smaller id stays, as anywhere else.
+        assert!(plan(&m, on_plane, |_| true, |_| None, &params)
             .remove
             .is_empty());
     }
