@@ -262,19 +262,19 @@ fn tbar(dir: &Path, name: &str, steps: u32, sets: &[&str]) -> Vec<f64> {
 #[test]
 #[ignore = "coarse benchmark: three softening T-bar runs at two velocities"]
 fn tbar_softening_takes_its_time_from_the_stage_velocity() {
-    // The stages' 20 mm/s give the steps 0.075 s each, and the clay near the bar is sheared
+    // The stages' 20 mm/s give the steps 0.025 s each, and the clay near the bar is sheared
     // faster than γ̇_ref = v/D: its resistance is above the rate-independent one. Halving the
-    // speed (0.15 s a step) lowers it again; without time the scene is refused.
+    // speed (0.05 s a step) lowers it again; without time the scene is refused.
     let dir = workdir("tbar-soft");
     let fast = tbar(&dir, "fast", 6, &[]);
     let plain = tbar(&dir, "plain", 6, &["material.rate_parameter=0.0"]);
-    let slow_stage = "rigid[0].stages[0]={ to = [0.0, -0.06], steps = 40, velocity = 0.01 }";
+    let slow_stage = "rigid[0].stages[0]={ to = [0.0, -0.06], steps = 120, velocity = 0.01 }";
     let slow = tbar(&dir, "slow", 6, &[slow_stage]);
     println!("Nc, 6 steps: 20 mm/s {fast:?}\n10 mm/s {slow:?}\nrate-independent {plain:?}");
     for k in 2..6 {
         assert!(fast[k] > slow[k] && slow[k] > plain[k], "step {}", k + 1);
     }
-    let untimed = "rigid[0].stages[0]={ to = [0.0, -0.06], steps = 40 }";
+    let untimed = "rigid[0].stages[0]={ to = [0.0, -0.06], steps = 120 }";
     let out = run(
         &dir,
         1,
