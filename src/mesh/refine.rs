@@ -160,9 +160,12 @@ pub fn plan(
             // top of a T-bar, where the soil closes behind it) the pair would otherwise close
             // to a sliver that Newton's iterates invert.
             if let [a, c] = along[p][..] {
+                // The distance first: `support_gap` is a boundary-condition and closest-point
+                // query, asked only of a neighbour that is already too close.
                 let close = [a, c].iter().any(|&q| {
-                    (mesh.gids[q as usize] < mesh.gids[p] || support_gap(q as usize).is_some())
-                        && dist(pu, q) < params.merge_distance * spacing(pu, q)
+                    dist(pu, q) < params.merge_distance * spacing(pu, q)
+                        && (mesh.gids[q as usize] < mesh.gids[p]
+                            || support_gap(q as usize).is_some())
                 });
                 if close && slides(p) && dist(a, c) < params.split_length * spacing(a, c) {
                     remove.push(pu);
