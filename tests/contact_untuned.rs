@@ -48,31 +48,36 @@ fn both_stages_on_one_and_two_ranks(name: &str, sets: &[&str]) -> (Vec<f64>, Vec
     (v, h)
 }
 
+/// Mean V/(B cu) over the last four steps of the push (z = 0.07–0.1 m, B/6 at the end).
+fn end_of_push(v: &[f64]) -> f64 {
+    v[6..10].iter().sum::<f64>() / 4.0
+}
+
 #[test]
 #[ignore = "coarse benchmark: untuned rough footing pushed and dragged on 1 and 2 ranks"]
 fn the_untuned_rough_footing_is_pushed_to_prandtls_load_and_dragged_on_one_and_two_ranks() {
     let (v, h) = both_stages_on_one_and_two_ranks("contact-untuned", &[]);
-    // Prandtl: 2 + π for a strip footing, smooth or rough. Measured 5.084 at z = B/6 (−1.1 %,
-    // six particles across B; 5.368 at h = 0.05 m): within 5 %.
+    // Prandtl: 2 + π for a strip footing, smooth or rough. With six particles across B the load
+    // scatters by ±4 % from step to step; its mean at the end of the push measured 5.250
+    // (+2.1 %): within 5 %.
     let prandtl = 2.0 + std::f64::consts::PI;
+    let push = end_of_push(&v);
     assert!(
-        (v[9] - prandtl).abs() < 0.05 * prandtl,
-        "V/(B cu) {} against {prandtl}",
-        v[9]
+        (push - prandtl).abs() < 0.05 * prandtl,
+        "V/(B cu) {push} against {prandtl}"
     );
     // Dragged at its depth d = B/6, the rough base slides on the clay (B cu) and the side faces
     // add Rankine's 2 cu d' each (passive in front, suction behind), d' the embedment with the
     // heave, at most 2d: H/(B cu) between 1 and 1 + 8 d/B = 2.33 once the base slides.
-    // Measured 1.49–1.70 over the last 10 steps (1.62–1.64 at h = 0.05 m).
+    // Measured 1.54–1.71 over the last 10 steps.
     for (i, hi) in h.iter().enumerate().skip(20) {
         assert!((1.0..2.33).contains(hi), "step {}: H/(B cu) {hi}", i + 1);
     }
-    // Sliding relieves the vertical load: V falls below its end-of-push value.
+    // Sliding relieves the vertical load: measured 1.70 at the end.
     assert!(
-        v[29] < 0.5 * v[9],
-        "V/(B cu) {} at the end against {} after the push",
-        v[29],
-        v[9]
+        v[29] < 0.5 * push,
+        "V/(B cu) {} at the end against {push} after the push",
+        v[29]
     );
 }
 
@@ -81,15 +86,15 @@ fn the_untuned_rough_footing_is_pushed_to_prandtls_load_and_dragged_on_one_and_t
 fn the_untuned_smooth_footing_is_pushed_and_dragged_on_one_and_two_ranks() {
     let (v, h) =
         both_stages_on_one_and_two_ranks("contact-untuned-smooth", &["rigid[0].adhesion=0"]);
-    // Measured 4.868 at z = B/6 (−5.3 %): within 7 % of Prandtl.
+    // Measured 5.126 (−0.3 %) at the end of the push: within 5 % of Prandtl.
     let prandtl = 2.0 + std::f64::consts::PI;
+    let push = end_of_push(&v);
     assert!(
-        (v[9] - prandtl).abs() < 0.07 * prandtl,
-        "V/(B cu) {} against {prandtl}",
-        v[9]
+        (push - prandtl).abs() < 0.05 * prandtl,
+        "V/(B cu) {push} against {prandtl}"
     );
     // A smooth base carries no shear: only the side faces resist, at most 8 d/B = 1.33 (as
-    // above); measured 0.31–0.66 from step 16 on.
+    // above); measured 0.26–0.62 from step 16 on.
     for (i, hi) in h.iter().enumerate().skip(15) {
         assert!(*hi > 0.0 && *hi < 1.33, "step {}: H/(B cu) {hi}", i + 1);
     }

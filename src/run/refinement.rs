@@ -16,9 +16,11 @@ const SLIDING_GAP: f64 = 0.1;
 /// (`deep_chords`).
 const MAX_CHORD_DEPTH: f64 = 0.1;
 
-/// ...if it is longer than this (in its spacing): its halves stay clear of the merge distance
-/// (0.4).
-const MIN_CHORD_SPLIT: f64 = 1.0;
+/// ...if it is longer than this (in its spacing): its halves are no closer than the merge
+/// distance (0.4). At 1.0, chords of 0.8–1.0 spacing round `footing-gradient`'s rounded edge
+/// (radius 0.8 spacing) cut 0.19 spacing into it unsplit, and their midside nodes, rebuilt
+/// straight at every remesh, stalled Newton at step 75.
+const MIN_CHORD_SPLIT: f64 = 0.8;
 
 impl Simulation {
     /// Collective. Inserts, removes and smooths particles as the scene asks; returns whether
