@@ -78,7 +78,7 @@ use mpi::traits::*;
 
 pub use collective::block_range;
 pub use error::{CaseError, CaseErrorKind};
-pub use gauss::{GaussRecords, CONTACT_LEN, GAUSS_POINTS, NODE_LEN};
+pub use gauss::{GaussRecords, BULGE_LEN, CONTACT_LEN, GAUSS_POINTS, NODE_LEN};
 pub use particles::ParticleSet;
 pub use write::{write_case, write_checkpoint};
 

@@ -42,6 +42,7 @@ fn base() -> (CaseHeader, ParticleSet, GaussRecords) {
         g.state.push(&vec![1.0; width]);
         g.nodes.push([f64::NAN; 18]);
         g.contact.push([f64::NAN; 18]);
+        g.bulge.push([f64::NAN; 3]);
     }
     assert!(g.len() > 10);
     (header, p, g)

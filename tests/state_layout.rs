@@ -76,10 +76,21 @@ fn a_version_1_elastic_case_drops_its_zero_plastic_columns() {
     let dir = workdir("v1-elastic");
     std::fs::copy(data("v1-cantilever.h5"), dir.join("c.h5")).unwrap();
     ok(&dir, 1, &["c.h5", "--out", "run"]);
-    assert_eq!(
+    // Step 1 is the version-1 program's bit for bit. Step 2 starts from a mesh whose boundary
+    // edges keep the curve the beam's bending gave them in step 1 (`mesh.curved_edges`, newer
+    // than version 1): it moved the tip by 3e-4 of its version-1 value, towards the exact one.
+    let (got, want) = (
         history_text(&dir.join("run/history.csv")),
-        history_text(&data("v1-cantilever-history.csv"))
+        history_text(&data("v1-cantilever-history.csv")),
     );
+    let lines = |t: &str| t.lines().map(str::to_string).collect::<Vec<_>>();
+    let (got, want) = (lines(&got), lines(&want));
+    assert_eq!(got.len(), 3, "{got:?}");
+    assert_eq!(got[..2], want[..2]);
+    let values = |l: &str| -> Vec<f64> { l.split(',').map(|x| x.parse().unwrap()).collect() };
+    for (a, b) in values(&got[2]).iter().zip(values(&want[2])) {
+        assert!((a - b).abs() <= 1e-3 * b.abs(), "step 2: {a} against {b}");
+    }
     let cp = dir.join("run/checkpoints/step_000002.h5");
     assert_eq!(h5_attr(&cp, "f['particles/state'].shape[1]"), "4");
     assert_eq!(h5_attr(&cp, "f['gauss/state'].shape[1]"), "12");

@@ -29,6 +29,10 @@ pub const NODE_LEN: usize = 18;
 /// Contact values per triangle: 6 nodes (as in `nodes`) x (rigid body index, contact pressure,
 /// shear stress), NaN where the node touched no body.
 pub const CONTACT_LEN: usize = 18;
+/// Curve values per triangle: the relative midside offset (`mesh::curved::bulge`, ends in gid
+/// order) of its edges 01, 12, 20 where the edge was a boundary edge at the end of the last
+/// increment, NaN elsewhere. The next remesh curves those edges again.
+pub const BULGE_LEN: usize = 3;
 const GROUP: &str = "gauss";
 
 /// Triangles (smallest-gid vertex first, CCW) with their Gauss states.
@@ -41,6 +45,8 @@ pub struct GaussRecords {
     pub nodes: Vec<[f64; NODE_LEN]>,
     /// NaN where no contact (or a file without `contact`).
     pub contact: Vec<[f64; CONTACT_LEN]>,
+    /// NaN where no curve (or a file without `bulge`).
+    pub bulge: Vec<[f64; BULGE_LEN]>,
 }
 
 impl GaussRecords {
@@ -108,6 +114,7 @@ pub(crate) fn write(
         at(),
         g.contact.as_flattened(),
     )?;
+    column_step(step, file, "bulge", BULGE_LEN, at(), g.bulge.as_flattened())?;
     let width = GAUSS_POINTS * columns.len();
     let ds = column_step(step, file, "state", width, at(), g.state.as_flat())?;
     let what = format!(
@@ -160,6 +167,7 @@ pub fn read(
         state: Rows::zeros(width, rows.len()),
         nodes: vec![[f64::NAN; NODE_LEN]; rows.len()],
         contact: vec![[f64::NAN; CONTACT_LEN]; rows.len()],
+        bulge: vec![[f64::NAN; BULGE_LEN]; rows.len()],
     };
     let contact = group.dataset("contact").ok();
     if let Some(cs) = contact.as_ref().map(|d| d.shape()) {
@@ -167,6 +175,15 @@ pub fn read(
             return Err(bad(
                 "contact",
                 format!("expected shape ({}, {CONTACT_LEN}), found {cs:?}", ks[0]),
+            ));
+        }
+    }
+    let bulge = group.dataset("bulge").ok();
+    if let Some(bs) = bulge.as_ref().map(|d| d.shape()) {
+        if bs.len() != 2 || bs[1] != BULGE_LEN || bs[0] != ks[0] {
+            return Err(bad(
+                "bulge",
+                format!("expected shape ({}, {BULGE_LEN}), found {bs:?}", ks[0]),
             ));
         }
     }
@@ -190,6 +207,13 @@ pub fn read(
                 contact,
                 &contact.space()?.select((rows.clone(), ..))?,
                 g.contact.as_flattened_mut(),
+            )?;
+        }
+        if let Some(bulge) = &bulge {
+            ffi::read_collective(
+                bulge,
+                &bulge.space()?.select((rows.clone(), ..))?,
+                g.bulge.as_flattened_mut(),
             )?;
         }
         if let Some(nodes) = &nodes {
@@ -234,5 +258,6 @@ pub fn verify(
     checksum::verify(comm, &key, first, 3, g.key.as_flattened()).map_err(|m| bad("key", m))?;
     check("nodes", NODE_LEN, g.nodes.as_flattened())?;
     check("contact", CONTACT_LEN, g.contact.as_flattened())?;
+    check("bulge", BULGE_LEN, g.bulge.as_flattened())?;
     check("state", g.state.width(), g.state.as_flat())
 }

@@ -15,7 +15,7 @@ use super::error::{CaseError, CaseErrorKind};
 use super::lockstep::{self, Lockstep};
 use super::state_columns;
 use super::{check_output, ffi, gauss, header, CaseHeader, GaussRecords, ParticleSet};
-use super::{CONTACT_LEN, GAUSS_POINTS, NODE_LEN};
+use super::{BULGE_LEN, CONTACT_LEN, GAUSS_POINTS, NODE_LEN};
 
 /// Writes this rank's rows `rows` of column `c` (collective).
 fn write_column<T: H5Type>(
@@ -177,7 +177,7 @@ pub fn write_checkpoint(
 
     let ranks = comm.size() as u32;
     let raw = total * datasets::bytes_per_particle(width)
-        + gtotal * (8 * (3 + GAUSS_POINTS * width + NODE_LEN + CONTACT_LEN)) as u64
+        + gtotal * (8 * (3 + GAUSS_POINTS * width + NODE_LEN + CONTACT_LEN + BULGE_LEN)) as u64
         + 8 * (header.tracked_gids.len() + header.rank_counts.len()) as u64;
     let text =
         (header.scene_toml.len() + header.scene_source.len() + header.code_version.len()) as u64;

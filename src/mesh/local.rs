@@ -36,6 +36,9 @@ pub struct LocalMesh {
     /// exact Delaunay triangulation: then every rank must rebuild without the pass, or the ranks'
     /// meshes may disagree.
     pub ties_settled: bool,
+    /// Midside positions of the curved edges (`super::curved`) by sorted gid pair, sorted; every
+    /// other edge is straight. The same on every rank that holds the edge.
+    pub curved: Vec<([u64; 2], [f64; 2])>,
 }
 
 #[derive(Debug)]
@@ -83,6 +86,7 @@ impl LocalMesh {
             on_boundary: Vec::new(),
             boundary_edges: Vec::new(),
             ties_settled,
+            curved: Vec::new(),
         };
         mesh.derive(rank);
         Ok(mesh)
@@ -152,6 +156,34 @@ impl LocalMesh {
     /// The triangle's global-id key (smallest gid first, CCW).
     pub fn tri_key(&self, t: usize) -> [u64; 3] {
         key(&self.tris[t], &self.gids)
+    }
+
+    /// The midside node of the edge between local points `a` and `b`: its curved position, or
+    /// the chord's midpoint.
+    pub fn midside(&self, a: u32, b: u32) -> [f64; 2] {
+        let (ga, gb) = (self.gids[a as usize], self.gids[b as usize]);
+        if !self.curved.is_empty() {
+            let key = if ga < gb { [ga, gb] } else { [gb, ga] };
+            if let Ok(i) = self.curved.binary_search_by_key(&key, |e| e.0) {
+                return self.curved[i].1;
+            }
+        }
+        let (pa, pb) = (self.points[a as usize], self.points[b as usize]);
+        [0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1])]
+    }
+
+    /// The six nodes of triangle `t` (vertices, then the midside nodes of edges 01, 12, 20).
+    pub fn element_nodes(&self, t: usize) -> [[f64; 2]; 6] {
+        let [a, b, c] = self.tris[t];
+        let p = |v: u32| self.points[v as usize];
+        [
+            p(a),
+            p(b),
+            p(c),
+            self.midside(a, b),
+            self.midside(b, c),
+            self.midside(c, a),
+        ]
     }
 
     /// Number of owned triangles (for balance and the fingerprint).

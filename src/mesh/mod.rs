@@ -3,6 +3,7 @@
 
 pub mod adapt;
 pub mod alpha;
+pub mod curved;
 pub mod delaunay;
 pub mod fingerprint;
 pub mod local;

@@ -73,7 +73,7 @@ impl Simulation {
             let nb = dofs.node_of_point[b as usize];
             let (xa, xb) = (mesh.points[a as usize], mesh.points[b as usize]);
             let len = ((xb[0] - xa[0]).powi(2) + (xb[1] - xa[1]).powi(2)).sqrt();
-            let mid = [0.5 * (xa[0] + xb[0]), 0.5 * (xa[1] + xb[1])];
+            let mid = mesh.midside(a, b);
             // The length (axisymmetry: the ring area) each node stands for, by Simpson's rule,
             // which is exact on a straight edge. A node on the axis stands for no area; it
             // carries its force R all the same, and the length of a ring an eighth of the edge
@@ -356,10 +356,11 @@ fn node_info(
         let p = dofs.node_point[n] as usize;
         (mesh.points[p], mesh.h[p], [mesh.gids[p]; 2])
     } else {
-        let [a, b] = dofs.edges[n - n_vertex].map(|p| p as usize);
-        let (xa, xb) = (mesh.points[a], mesh.points[b]);
+        let [a, b] = dofs.edges[n - n_vertex];
+        let mid = mesh.midside(a, b);
+        let [a, b] = [a as usize, b as usize];
         (
-            [0.5 * (xa[0] + xb[0]), 0.5 * (xa[1] + xb[1])],
+            mid,
             mesh.h[a].max(mesh.h[b]),
             edge_key(mesh.gids[a], mesh.gids[b]),
         )

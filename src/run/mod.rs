@@ -3,6 +3,7 @@
 mod adapt;
 mod boundary_rules;
 mod contact;
+mod curved_edges;
 mod error;
 mod geostatic;
 mod node_values;

@@ -153,6 +153,11 @@ impl Simulation {
             let (sa, sb) = (value(a), value(b));
             let state: Vec<f64> = sa.iter().zip(sb).map(|(x, y)| 0.5 * (x + y)).collect();
             let (mut x, mut u) = (mid(mesh.points[a], mesh.points[b]), mid(disp(a), disp(b)));
+            // A curved boundary edge is split on its curve, where its soil is.
+            if let Some(c) = self.curved_midside(mesh, a, b) {
+                u = [u[0] + c[0] - x[0], u[1] + c[1] - x[1]];
+                x = c;
+            }
             // A boundary chord round a body's corner cuts into the body: its new particle goes
             // onto the body's surface, where the soil it stands for is, instead of starting
             // inside and held there by the contact's start offset. (Only positions decide, so

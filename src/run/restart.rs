@@ -4,7 +4,7 @@
 
 use super::Simulation;
 use crate::case_file::{
-    write_checkpoint, GaussRecords, ParticleSet, CONTACT_LEN, GAUSS_POINTS, NODE_LEN,
+    write_checkpoint, GaussRecords, ParticleSet, BULGE_LEN, CONTACT_LEN, GAUSS_POINTS, NODE_LEN,
 };
 use crate::mapping::TriStates;
 use crate::material::Rows;
@@ -86,6 +86,13 @@ impl Simulation {
                     }
                 }
                 records.contact.push(contact);
+                let bulge = [[0, 1], [1, 2], [2, 0]].map(|[i, j]| {
+                    let edge = super::step::edge_key(key[i], key[j]);
+                    self.bulges
+                        .binary_search_by_key(&edge, |e| e.0)
+                        .map_or(f64::NAN, |i| self.bulges[i].1)
+                });
+                records.bulge.push(bulge);
             }
         }
         records
@@ -116,6 +123,7 @@ impl Simulation {
                 send[r as usize].extend(records.state.row(t).iter().map(|x| x.to_bits()));
                 send[r as usize].extend(records.nodes[t].iter().map(|x| x.to_bits()));
                 send[r as usize].extend(records.contact[t].iter().map(|x| x.to_bits()));
+                send[r as usize].extend(records.bulge[t].iter().map(|x| x.to_bits()));
             }
         }
         let received = alltoallv(world, &send);
@@ -123,7 +131,7 @@ impl Simulation {
         let chunks = || {
             received
                 .iter()
-                .flat_map(|r| r.chunks_exact(3 + gw + NODE_LEN + CONTACT_LEN))
+                .flat_map(|r| r.chunks_exact(3 + gw + NODE_LEN + CONTACT_LEN + BULGE_LEN))
         };
         let mut last = Vec::new();
         for c in chunks() {
@@ -150,6 +158,17 @@ impl Simulation {
             }
         }
         drop(touching);
+        let mut bulges = Vec::new();
+        for c in chunks() {
+            let bulge = &c[3 + gw + NODE_LEN + CONTACT_LEN..];
+            for (k, [i, j]) in [[0, 1], [1, 2], [2, 0]].into_iter().enumerate() {
+                let s = f64::from_bits(bulge[k]);
+                if !s.is_nan() {
+                    bulges.push((super::step::edge_key(c[i], c[j]), s));
+                }
+            }
+        }
+        self.bulges = super::curved_edges::gather(world, &bulges);
         let mut keys = Vec::new();
         let mut states = Rows::new(gw);
         for c in chunks() {

@@ -57,6 +57,8 @@ pub struct Simulation {
     pub(super) halo: Option<pfem_partition::Halo>,
     /// The step after which `[mesh.adapt]` last set the spacings (once per step, not per piece).
     pub(super) adapted_at: Option<u64>,
+    /// The curves of the last mesh's boundary edges (`super::curved_edges`), every rank's.
+    pub(super) bulges: super::curved_edges::Bulges,
     first_step: u64,
 }
 
@@ -133,6 +135,7 @@ impl Simulation {
             remapped: Default::default(),
             halo: None,
             adapted_at: None,
+            bulges: Vec::new(),
         };
         if world.size() > 1 && !same_partition {
             sim.repartition(world, Repartition::Always)?;
@@ -174,8 +177,9 @@ impl Simulation {
         let mut mesh = self.build_mesh(world, &previous)?;
         self.adapt_spacing(world, &mut mesh);
         if self.refine(world, &mesh)? {
-            return self.build_mesh(world, &previous);
+            mesh = self.build_mesh(world, &previous)?;
         }
+        self.curve_boundary(world, &mut mesh);
         Ok(mesh)
     }
 

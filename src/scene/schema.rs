@@ -219,6 +219,12 @@ pub struct Mesh {
     /// left unchanged. For studying the cost of mapping. Default false.
     #[serde(default)]
     pub remap_all: bool,
+    /// Keep the curve a boundary edge's midside node took in the last increment across the
+    /// remesh, while its two particles stay joined on the boundary (`mesh::curved`): the soil
+    /// stays wrapped round a rigid body's rounded corner instead of its chords cutting in.
+    /// Default true.
+    #[serde(default = "default_true")]
+    pub curved_edges: bool,
     /// Nested finer lattices, e.g. around a footing edge: `fine = [{ origin = [0.5, 9.5],
     /// size = [1.0, 0.5], h = 0.0625 }]`. Where regions overlap the finest spacing wins. Default
     /// none.

@@ -9,7 +9,6 @@ use super::{Constraints, DofMap};
 use crate::fem::analysis::Analysis;
 use crate::fem::element::p2_element_with;
 use crate::fem::mixed::p2p1_element;
-use crate::fem::p2::straight_sided;
 use crate::fem::surface_load::edge_pressure_in;
 use crate::mapping::StartStates;
 use crate::mapping::{push_states, POINTS};
@@ -243,9 +242,9 @@ impl<'a> StepProblem<'a> {
         self.dofs.tri_nodes.len()
     }
 
-    /// Start-of-step nodes of triangle `t` (straight sided).
+    /// Start-of-step nodes of triangle `t` (its curved boundary edges curved).
     fn geometry(&self, t: usize) -> [[f64; 2]; 6] {
-        straight_sided(&self.mesh.tris[t].map(|v| self.mesh.points[v as usize]))
+        self.mesh.element_nodes(t)
     }
 
     /// Assembles `schur` with every Jacobian (mixed kernels only).
@@ -697,14 +696,15 @@ impl<'a> StepProblem<'a> {
         [x0[0] + u[0], x0[1] + u[1]]
     }
 
-    /// Start-of-step position of local node `n` (an edge node at its chord's midpoint).
+    /// Start-of-step position of local node `n` (an edge node on its curve, or at its chord's
+    /// midpoint).
     pub fn node_start(&self, n: usize) -> [f64; 2] {
         let n_vertex = self.dofs.n_nodes() - self.dofs.edges.len();
         if n < n_vertex {
             self.mesh.points[self.dofs.node_point[n] as usize]
         } else {
-            let [a, b] = self.dofs.edges[n - n_vertex].map(|p| self.mesh.points[p as usize]);
-            [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]
+            let [a, b] = self.dofs.edges[n - n_vertex];
+            self.mesh.midside(a, b)
         }
     }
 

@@ -1,0 +1,155 @@
+//! Curved boundary edges carried across a remesh (`crate::mesh::curved`): recorded from each
+//! converged increment, given back to the boundary edges of the next mesh that join the same two
+//! particles. The table is small (one entry per boundary edge) and every rank keeps all of it,
+//! so a mesh's curves do not depend on the partition, and a checkpoint restarts on any rank count.
+
+use super::step::edge_key;
+use super::Simulation;
+use crate::mesh::curved::{bulge, keeps_shape, midside, MAX_BULGE, MIN_BULGE};
+use crate::mesh::LocalMesh;
+use crate::solve::DofMap;
+use pfem_partition::{allgather_u64, Comm};
+use std::collections::{HashMap, HashSet};
+
+/// Relative midside offset ([`bulge`]) per boundary edge, by sorted gid pair, sorted.
+pub(super) type Bulges = Vec<([u64; 2], f64)>;
+
+/// Collective. Every rank's entries, sorted by key, of repeated keys the first (they are equal:
+/// computed from the same bits on every rank that holds the edge).
+pub(super) fn gather(world: &Comm, local: &[([u64; 2], f64)]) -> Bulges {
+    let flat: Vec<u64> = local
+        .iter()
+        .flat_map(|(k, s)| [k[0], k[1], s.to_bits()])
+        .collect();
+    let mut all: Bulges = allgather_u64(world, &flat)
+        .chunks_exact(3)
+        .map(|c| ([c[0], c[1]], f64::from_bits(c[2])))
+        .collect();
+    all.sort_by_key(|e| e.0);
+    all.dedup_by_key(|e| e.0);
+    all
+}
+
+/// Sorted gid keys of the boundary edges of `mesh` that touch an owned particle.
+fn boundary_keys(mesh: &LocalMesh) -> HashSet<[u64; 2]> {
+    mesh.boundary_edges
+        .iter()
+        .map(|e| edge_key(mesh.gids[e[0] as usize], mesh.gids[e[1] as usize]))
+        .collect()
+}
+
+impl Simulation {
+    /// Where the last increment left the midside node of the boundary edge between local points
+    /// `a` and `b` of `mesh` (a mesh of the current particles), if it recorded a curve there.
+    pub(super) fn curved_midside(&self, mesh: &LocalMesh, a: usize, b: usize) -> Option<[f64; 2]> {
+        let (mut a, mut b) = (a, b);
+        if mesh.gids[a] > mesh.gids[b] {
+            std::mem::swap(&mut a, &mut b);
+        }
+        let key = [mesh.gids[a], mesh.gids[b]];
+        let i = self.bulges.binary_search_by_key(&key, |e| e.0).ok()?;
+        Some(midside(mesh.points[a], mesh.points[b], self.bulges[i].1))
+    }
+
+    /// Collective. Records the curve of every boundary edge of `mesh` at the end of the
+    /// increment `du` (per node of `dofs`).
+    pub(super) fn record_bulges(
+        &mut self,
+        world: &Comm,
+        mesh: &LocalMesh,
+        dofs: &DofMap,
+        du: &[[f64; 2]],
+    ) {
+        if !self.model.scene.mesh.curved_edges {
+            return;
+        }
+        let boundary = boundary_keys(mesh);
+        let mut local = Vec::with_capacity(boundary.len());
+        let moved = |node: u32, x: [f64; 2]| {
+            let d = du[node as usize];
+            [x[0] + d[0], x[1] + d[1]]
+        };
+        for (t, tri) in mesh.tris.iter().enumerate() {
+            for (k, [i, j]) in crate::fem::p2::EDGES.iter().enumerate() {
+                let (mut a, mut b) = (tri[*i], tri[*j]);
+                if mesh.gids[a as usize] > mesh.gids[b as usize] {
+                    std::mem::swap(&mut a, &mut b);
+                }
+                let key = [mesh.gids[a as usize], mesh.gids[b as usize]];
+                if !boundary.contains(&key) {
+                    continue;
+                }
+                let nodes = dofs.tri_nodes[t];
+                let xa = moved(dofs.node_of_point[a as usize], mesh.points[a as usize]);
+                let xb = moved(dofs.node_of_point[b as usize], mesh.points[b as usize]);
+                let xm = moved(nodes[3 + k], mesh.midside(a, b));
+                let s = bulge(xa, xb, xm);
+                if (MIN_BULGE..=MAX_BULGE).contains(&s.abs()) {
+                    local.push((key, s));
+                }
+            }
+        }
+        self.bulges = gather(world, &local);
+    }
+
+    /// Collective. Curves the boundary edges of the new `mesh` that were boundary edges of the
+    /// last one (the same two particles), unless that folds their triangle; the triangle's owner
+    /// decides, every rank applies.
+    pub(super) fn curve_boundary(&self, world: &Comm, mesh: &mut LocalMesh) {
+        mesh.curved.clear();
+        if !self.model.scene.mesh.curved_edges {
+            return;
+        }
+        // Boundary edges of the new mesh with a recorded curve: every rank's, so that an edge
+        // of a triangle this rank holds whose particles are both ghosts is known as well.
+        let found = |key: &[u64; 2]| self.bulges.binary_search_by_key(key, |e| e.0).ok();
+        let local: Vec<([u64; 2], f64)> = boundary_keys(mesh)
+            .into_iter()
+            .filter_map(|k| found(&k).map(|i| self.bulges[i]))
+            .collect();
+        let candidates = gather(world, &local);
+        if candidates.is_empty() {
+            return;
+        }
+        let index: HashMap<u64, u32> = mesh
+            .gids
+            .iter()
+            .enumerate()
+            .map(|(i, &g)| (g, i as u32))
+            .collect();
+        let place = |key: &[u64; 2], s: f64| -> Option<[f64; 2]> {
+            let a = *index.get(&key[0])?;
+            let b = *index.get(&key[1])?;
+            Some(midside(mesh.points[a as usize], mesh.points[b as usize], s))
+        };
+        mesh.curved = candidates
+            .iter()
+            .filter_map(|(k, s)| place(k, *s).map(|m| (*k, m)))
+            .collect();
+        // The owner of each triangle with a curved edge checks its shape.
+        let mut rejected = Vec::new();
+        for t in 0..mesh.tris.len() {
+            if !mesh.tri_owned[t] {
+                continue;
+            }
+            let key = mesh.tri_key(t);
+            let edges = [[0, 1], [1, 2], [2, 0]].map(|[i, j]| edge_key(key[i], key[j]));
+            let curved: Vec<[u64; 2]> = edges
+                .into_iter()
+                .filter(|e| mesh.curved.binary_search_by_key(e, |c| c.0).is_ok())
+                .collect();
+            if !curved.is_empty() && !keeps_shape(&mesh.element_nodes(t)) {
+                rejected.extend(curved.iter().flat_map(|e| [e[0], e[1], 0]));
+            }
+        }
+        let rejected = gather(
+            world,
+            &rejected
+                .chunks_exact(3)
+                .map(|c| ([c[0], c[1]], 0.0))
+                .collect::<Vec<_>>(),
+        );
+        mesh.curved
+            .retain(|(k, _)| rejected.binary_search_by_key(k, |e| e.0).is_err());
+    }
+}
