@@ -30,6 +30,38 @@ pub(super) fn gather(world: &Comm, local: &[([u64; 2], f64)]) -> Bulges {
     all
 }
 
+/// The curve `s` of chord `a`→`b`, or as much of it as keeps its midside node out of every rigid
+/// body: the last increment kept the node out of the body only where it was a contact node, and
+/// a node left inside would stay inside, the contact holding it at its starting depth. Only
+/// positions decide, so every rank finds the same.
+fn outside_bodies(shapes: &[crate::rigid::Shape], a: [f64; 2], b: [f64; 2], s: f64) -> f64 {
+    let depth = |s: f64| {
+        let m = midside(a, b, s);
+        shapes
+            .iter()
+            .map(|shape| shape.closest(m).distance)
+            .fold(f64::INFINITY, f64::min)
+    };
+    if depth(s) >= 0.0 {
+        return s;
+    }
+    if depth(0.0) < 0.0 {
+        // The chord itself cuts in: the shallower of the two.
+        return if depth(0.0) >= depth(s) { 0.0 } else { s };
+    }
+    // Out at 0, in at s: the crossing, from the outside.
+    let (mut out, mut inside) = (0.0, s);
+    for _ in 0..40 {
+        let half = 0.5 * (out + inside);
+        if depth(half) >= 0.0 {
+            out = half;
+        } else {
+            inside = half;
+        }
+    }
+    out
+}
+
 /// Sorted gid keys of the boundary edges of `mesh` that touch an owned particle.
 fn boundary_keys(mesh: &LocalMesh) -> HashSet<[u64; 2]> {
     mesh.boundary_edges
@@ -117,10 +149,12 @@ impl Simulation {
             .enumerate()
             .map(|(i, &g)| (g, i as u32))
             .collect();
+        let lambda = self.header.load_factor;
+        let shapes: Vec<_> = self.model.bodies.iter().map(|b| b.shape(lambda)).collect();
         let place = |key: &[u64; 2], s: f64| -> Option<[f64; 2]> {
-            let a = *index.get(&key[0])?;
-            let b = *index.get(&key[1])?;
-            Some(midside(mesh.points[a as usize], mesh.points[b as usize], s))
+            let a = mesh.points[*index.get(&key[0])? as usize];
+            let b = mesh.points[*index.get(&key[1])? as usize];
+            Some(midside(a, b, outside_bodies(&shapes, a, b, s)))
         };
         mesh.curved = candidates
             .iter()
@@ -151,5 +185,29 @@ impl Simulation {
         );
         mesh.curved
             .retain(|(k, _)| rejected.binary_search_by_key(k, |e| e.0).is_err());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rigid::Shape;
+
+    #[test]
+    fn a_curve_into_a_body_stops_at_its_surface() {
+        // A unit circle below the chord y = 1.1 from x = -0.5 to 0.5: the chord's midpoint is
+        // 0.1 above it; a downward curve of 0.3 of the chord would put the node 0.2 inside.
+        let circle = [Shape::circle([0.0, 0.0], 1.0).unwrap()];
+        let (a, b) = ([-0.5, 1.1], [0.5, 1.1]);
+        let s = outside_bodies(&circle, a, b, 0.3);
+        let m = midside(a, b, s);
+        assert!((m[1] - 1.0).abs() < 1e-9 && m[0].abs() < 1e-15, "{m:?}");
+        // A curve away from the body, or with no body, is kept.
+        assert_eq!(outside_bodies(&circle, a, b, -0.2), -0.2);
+        assert_eq!(outside_bodies(&[], a, b, 0.3), 0.3);
+        // A chord cutting in keeps whichever of chord and curve lies shallower.
+        let (a, b) = ([-0.5, 0.95], [0.5, 0.95]);
+        assert_eq!(outside_bodies(&circle, a, b, 0.1), 0.0);
+        assert_eq!(outside_bodies(&circle, a, b, -0.1), -0.1);
     }
 }
