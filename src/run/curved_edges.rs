@@ -11,6 +11,18 @@ use crate::solve::DofMap;
 use pfem_partition::{allgather_u64, Comm};
 use std::collections::{HashMap, HashSet};
 
+/// A midside node within this fraction of its spacing of a rigid body at the end of the
+/// increment lies on it.
+const ON_BODY: f64 = 0.01;
+
+/// On a rigid body a curve is kept only where the straight chord would cut into the body by at
+/// least this fraction of the spacing: round a corner of radius 1.6 spacings (the built-in
+/// footing's) a chord cuts in by 0.08, round the T-bars' circles (radius 4 spacings) by 0.03,
+/// which the contact's start offset already holds. Carried there as well, the shallow curves made
+/// single steps of the smooth T-bar dip by up to 10 % (the cause not found; measured 2026-11-28,
+/// bench/VALIDATION.md); free surfaces keep every curve.
+const DEEP_CHORD: f64 = 0.05;
+
 /// Relative midside offset ([`bulge`]) per boundary edge, by sorted gid pair, sorted.
 pub(super) type Bulges = Vec<([u64; 2], f64)>;
 
@@ -84,17 +96,20 @@ impl Simulation {
     }
 
     /// Collective. Records the curve of every boundary edge of `mesh` at the end of the
-    /// increment `du` (per node of `dofs`).
+    /// increment `du` (per node of `dofs`) that ends at load factor `to`: on free surfaces
+    /// all, on rigid bodies the deep ones ([`DEEP_CHORD`]).
     pub(super) fn record_bulges(
         &mut self,
         world: &Comm,
         mesh: &LocalMesh,
         dofs: &DofMap,
         du: &[[f64; 2]],
+        to: f64,
     ) {
         if !self.model.scene.mesh.curved_edges {
             return;
         }
+        let shapes: Vec<_> = self.model.bodies.iter().map(|b| b.shape(to)).collect();
         let boundary = boundary_keys(mesh);
         let mut local = Vec::with_capacity(boundary.len());
         let moved = |node: u32, x: [f64; 2]| {
@@ -116,7 +131,13 @@ impl Simulation {
                 let xb = moved(dofs.node_of_point[b as usize], mesh.points[b as usize]);
                 let xm = moved(nodes[3 + k], mesh.midside(a, b));
                 let s = bulge(xa, xb, xm);
-                if (MIN_BULGE..=MAX_BULGE).contains(&s.abs()) {
+                let h = mesh.h[a as usize].max(mesh.h[b as usize]);
+                let on_body = shapes
+                    .iter()
+                    .any(|sh| sh.closest(xm).distance <= ON_BODY * h);
+                let len = (xb[0] - xa[0]).hypot(xb[1] - xa[1]);
+                let keep = !on_body || s.abs() * len >= DEEP_CHORD * h;
+                if keep && (MIN_BULGE..=MAX_BULGE).contains(&s.abs()) {
                     local.push((key, s));
                 }
             }

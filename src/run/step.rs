@@ -732,7 +732,8 @@ impl Simulation {
         solved: Solved,
         completes: bool,
     ) -> Result<StepReport, super::RunError> {
-        self.record_bulges(world, mesh, &solved.dofs, &solved.du);
+        let to = self.header.load_factor + solved.dlambda;
+        self.record_bulges(world, mesh, &solved.dofs, &solved.du, to);
         // Increments are kept per whole step: the predictor of the next increment scales them.
         let per_step = 1.0 / (solved.dlambda * self.model.scene.steps.count as f64);
         for i in 0..self.particles.len() {
