@@ -221,8 +221,9 @@ pub struct Mesh {
     pub remap_all: bool,
     /// Keep the curve a boundary edge's midside node took in the last increment across the
     /// remesh, while its two particles stay joined on the boundary (`mesh::curved`): the soil
-    /// stays wrapped round a rigid body's rounded corner instead of its chords cutting in.
-    /// Default true.
+    /// stays wrapped round a rigid body's rounded corner instead of its chords cutting in. On a
+    /// rigid body only where the straight chord would cut in by 0.05 spacing or more. Default
+    /// true.
     #[serde(default = "default_true")]
     pub curved_edges: bool,
     /// Nested finer lattices, e.g. around a footing edge: `fine = [{ origin = [0.5, 9.5],
