@@ -169,33 +169,23 @@ pub fn read(
         contact: vec![[f64::NAN; CONTACT_LEN]; rows.len()],
         bulge: vec![[f64::NAN; BULGE_LEN]; rows.len()],
     };
-    let contact = group.dataset("contact").ok();
-    if let Some(cs) = contact.as_ref().map(|d| d.shape()) {
-        if cs.len() != 2 || cs[1] != CONTACT_LEN || cs[0] != ks[0] {
+    // The optional per-triangle datasets: absent in older files, else one row per key.
+    let optional = |name: &str, width: usize| -> Result<Option<Dataset>, CaseError> {
+        let Ok(ds) = group.dataset(name) else {
+            return Ok(None);
+        };
+        let shape = ds.shape();
+        if shape.len() != 2 || shape[1] != width || shape[0] != ks[0] {
             return Err(bad(
-                "contact",
-                format!("expected shape ({}, {CONTACT_LEN}), found {cs:?}", ks[0]),
+                name,
+                format!("expected shape ({}, {width}), found {shape:?}", ks[0]),
             ));
         }
-    }
-    let bulge = group.dataset("bulge").ok();
-    if let Some(bs) = bulge.as_ref().map(|d| d.shape()) {
-        if bs.len() != 2 || bs[1] != BULGE_LEN || bs[0] != ks[0] {
-            return Err(bad(
-                "bulge",
-                format!("expected shape ({}, {BULGE_LEN}), found {bs:?}", ks[0]),
-            ));
-        }
-    }
-    let nodes = group.dataset("nodes").ok();
-    if let Some(ns) = nodes.as_ref().map(|d| d.shape()) {
-        if ns.len() != 2 || ns[1] != NODE_LEN || ns[0] != ks[0] {
-            return Err(bad(
-                "nodes",
-                format!("expected shape ({}, {NODE_LEN}), found {ns:?}", ks[0]),
-            ));
-        }
-    }
+        Ok(Some(ds))
+    };
+    let contact = optional("contact", CONTACT_LEN)?;
+    let bulge = optional("bulge", BULGE_LEN)?;
+    let nodes = optional("nodes", NODE_LEN)?;
     let read = (|| {
         ffi::read_collective(
             &key,

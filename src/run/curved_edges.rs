@@ -188,7 +188,7 @@ impl Simulation {
                 continue;
             }
             let key = mesh.tri_key(t);
-            let edges = [[0, 1], [1, 2], [2, 0]].map(|[i, j]| edge_key(key[i], key[j]));
+            let edges = crate::fem::p2::EDGES.map(|[i, j]| edge_key(key[i], key[j]));
             let curved: Vec<[u64; 2]> = edges
                 .into_iter()
                 .filter(|e| mesh.curved.binary_search_by_key(e, |c| c.0).is_ok())

@@ -86,7 +86,7 @@ impl Simulation {
                     }
                 }
                 records.contact.push(contact);
-                let bulge = [[0, 1], [1, 2], [2, 0]].map(|[i, j]| {
+                let bulge = crate::fem::p2::EDGES.map(|[i, j]| {
                     let edge = super::step::edge_key(key[i], key[j]);
                     self.bulges
                         .binary_search_by_key(&edge, |e| e.0)
@@ -161,7 +161,7 @@ impl Simulation {
         let mut bulges = Vec::new();
         for c in chunks() {
             let bulge = &c[3 + gw + NODE_LEN + CONTACT_LEN..];
-            for (k, [i, j]) in [[0, 1], [1, 2], [2, 0]].into_iter().enumerate() {
+            for (k, [i, j]) in crate::fem::p2::EDGES.into_iter().enumerate() {
                 let s = f64::from_bits(bulge[k]);
                 if !s.is_nan() {
                     bulges.push((super::step::edge_key(c[i], c[j]), s));
