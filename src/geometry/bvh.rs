@@ -103,16 +103,24 @@ impl SegmentTree {
     /// Distance from `p` to the nearest segment and that segment's index (the smallest index
     /// among equally near ones); `None` without segments.
     pub fn nearest(&self, p: Point) -> Option<(f64, usize)> {
-        let mut best = None;
-        if !self.nodes.is_empty() {
-            self.visit(0, p, &mut best);
-        }
-        best
+        self.nearest_counted(p).0
     }
 
-    fn visit(&self, node: usize, p: Point, best: &mut Option<(f64, usize)>) {
+    /// [`nearest`](Self::nearest) and its work: the segment and box distances it evaluated
+    /// (what a test of the query's cost counts, since timings depend on the machine's load).
+    pub fn nearest_counted(&self, p: Point) -> (Option<(f64, usize)>, usize) {
+        let mut best = None;
+        let mut work = 0;
+        if !self.nodes.is_empty() {
+            self.visit(0, p, &mut best, &mut work);
+        }
+        (best, work)
+    }
+
+    fn visit(&self, node: usize, p: Point, best: &mut Option<(f64, usize)>, work: &mut usize) {
         let n = &self.nodes[node];
         if n.count > 0 {
+            *work += n.count as usize;
             for &s in &self.order[n.first as usize..(n.first + n.count) as usize] {
                 let [a, b] = self.segs[s as usize];
                 let (d, s) = (segment::distance(a, b, p), s as usize);
@@ -123,16 +131,17 @@ impl SegmentTree {
             return;
         }
         let (l, r) = (n.first as usize, n.first as usize + 1);
+        *work += 2;
         let (dl, dr) = (self.box_distance(l, p), self.box_distance(r, p));
         let (near, far, dfar) = if dl <= dr { (l, r, dr) } else { (r, l, dl) };
         let dnear = dl.min(dr);
         // Boxes are pruned only when clearly farther than the best, so rounding in the box
         // distance never loses the nearest segment.
         if best.is_none_or(|(d, _)| dnear * (1.0 - 1e-12) <= d) {
-            self.visit(near, p, best);
+            self.visit(near, p, best, work);
         }
         if best.is_none_or(|(d, _)| dfar * (1.0 - 1e-12) <= d) {
-            self.visit(far, p, best);
+            self.visit(far, p, best, work);
         }
     }
 

@@ -49,6 +49,23 @@ impl Locator {
     }
 }
 
+/// The segments `locate` tests at `p`: those of the (sub)cell it ends in.
+#[cfg(test)]
+pub(super) fn locate_work(locator: &Locator, p: Point) -> usize {
+    let (mut grid, mut table) = (&locator.grid, &locator.table);
+    if !(p[0].is_finite() && p[1].is_finite() && grid.inside_grid(p)) {
+        return 0;
+    }
+    loop {
+        let (i, j) = grid.cell_of(p);
+        let c = j * grid.dims().0 + i;
+        match (grid.sub(i, j), table.subs.get(&c)) {
+            (Some(sub), Some(sub_table)) => (grid, table) = (&sub.grid, sub_table),
+            _ => return grid.cell_items(i, j).len(),
+        }
+    }
+}
+
 fn locate_in(grid: &EdgeGrid, table: &RefTable, p: Point) -> Location {
     let (i, j) = grid.cell_of(p);
     let c = j * grid.dims().0 + i;
