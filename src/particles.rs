@@ -30,8 +30,12 @@ pub struct Particles {
 }
 
 /// A particle closer to the axis of an axisymmetric body than this fraction of its spacing is
-/// put on it.
-pub const AXIS_SNAP: f64 = 0.1;
+/// put on it. Half the spacing, not less: particles on the axis only move along it, and those
+/// behind a penetrating body are merged at its rear stagnation point, so the axis is stripped
+/// behind the body; soil closing in from the sides must be put back on it, or a slit a few
+/// millimetres wide stays open along the axis in the wake (the `ball` lost 2-7 % of its
+/// resistance after w/D = 0.85 with a tenth of the spacing).
+pub const AXIS_SNAP: f64 = 0.5;
 
 impl Particles {
     /// Rank-local. Puts on the axis (x = 0) every particle that has come within [`AXIS_SNAP`] of
@@ -172,7 +176,7 @@ mod tests {
     fn particles_near_the_axis_are_put_on_it_keeping_their_reference_position() {
         let mut p = Particles {
             gid: vec![1, 2, 3, 4],
-            position: vec![[0.04, 1.0], [0.06, 2.0], [0.0, 3.0], [-0.01, 4.0]],
+            position: vec![[0.04, 1.0], [0.3, 2.0], [0.0, 3.0], [-0.01, 4.0]],
             displacement: vec![[-0.01, 0.5], [0.0, 0.0], [0.0, 0.0], [-0.02, 0.0]],
             increment: vec![[-0.01, 0.1]; 4],
             h: vec![0.5, 0.5, 0.5, 0.5],
@@ -185,7 +189,7 @@ mod tests {
             .collect();
         assert_eq!(p.snap_to_axis(), 2);
         assert_eq!(p.position[0], [0.0, 1.0]);
-        assert_eq!(p.position[1], [0.06, 2.0], "0.12 h off the axis stays");
+        assert_eq!(p.position[1], [0.3, 2.0], "0.6 h off the axis stays");
         assert_eq!(p.position[2], [0.0, 3.0]);
         assert_eq!(
             p.position[3],
