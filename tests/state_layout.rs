@@ -1,6 +1,9 @@
 //! The material state as each model lays it out: version-1 case files (nine state columns for
-//! every model, no `names`) load and continue bit for bit; new files are as wide as the model's
+//! every model, no `names`) load and continue as that program did; new files are as wide as the model's
 //! layout and name their columns; the field output carries one field per internal variable.
+//! "Bit for bit" is to 1e-12 of each value: the direct solver's libraries (MUMPS, BLAS) of
+//! another build round the last digit differently (4e-15 between two Debian installs), while a
+//! misread state column moves the history by far more.
 //!
 //! `tests/data/v1-*` were written by pfem-mpi at bcc2ea4 (format version 1), with the histories
 //! that binary produced from them on 1 rank:
@@ -20,9 +23,33 @@ fn data(name: &str) -> std::path::PathBuf {
         .join(name)
 }
 
-/// The history file's text, bit for bit (the numbers are printed shortest-round-trip).
+/// The history file's text (the numbers are printed shortest-round-trip).
 fn history_text(path: &Path) -> String {
     std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// Asserts that two history lines have the same fields, numbers within `rtol` of each other.
+fn assert_same_line(got: &str, want: &str, rtol: f64, what: &str) {
+    let (g, w): (Vec<&str>, Vec<&str>) = (got.split(',').collect(), want.split(',').collect());
+    assert_eq!(g.len(), w.len(), "{what}: {got} against {want}");
+    for (a, b) in g.iter().zip(&w) {
+        match (a.parse::<f64>(), b.parse::<f64>()) {
+            (Ok(x), Ok(y)) => assert!(
+                (x - y).abs() <= rtol * y.abs(),
+                "{what}: {x} against {y} ({got} against {want})"
+            ),
+            _ => assert_eq!(a, b, "{what}"),
+        }
+    }
+}
+
+/// Asserts that two history files have the same header and rows, numbers within `rtol`.
+fn assert_same_history(got: &str, want: &str, rtol: f64, what: &str) {
+    let (g, w): (Vec<&str>, Vec<&str>) = (got.lines().collect(), want.lines().collect());
+    assert_eq!(g.len(), w.len(), "{what}: {got} against {want}");
+    for (a, b) in g.iter().zip(&w) {
+        assert_same_line(a, b, rtol, what);
+    }
 }
 
 fn h5_attr(file: &Path, expr: &str) -> String {
@@ -48,17 +75,18 @@ fn h5py(file: &Path, mode: &str, code: &str) -> String {
 }
 
 #[test]
-fn a_version_1_tresca_checkpoint_continues_bit_for_bit() {
+fn a_version_1_tresca_checkpoint_continues_as_the_version_1_program_did() {
     let dir = workdir("v1-tresca");
     let case = dir.join("step4.h5");
     std::fs::copy(data("v1-block-compression-step4.h5"), &case).unwrap();
     let info = ok(&dir, 1, &["info", "step4.h5"]);
     assert!(info.contains("version 1"), "{info}");
     ok(&dir, 1, &["step4.h5", "--out", "cont"]);
-    assert_eq!(
-        history_text(&dir.join("cont/history.csv")),
-        history_text(&data("v1-block-compression-continued.csv")),
-        "steps 5-8 from a version-1 checkpoint must be the version-1 program's, bit for bit"
+    assert_same_history(
+        &history_text(&dir.join("cont/history.csv")),
+        &history_text(&data("v1-block-compression-continued.csv")),
+        1e-12,
+        "steps 5-8 from a version-1 checkpoint must be the version-1 program's",
     );
     // Its own checkpoint is version 2, with the Tresca layout named column by column.
     let cp = dir.join("cont/checkpoints/step_000008.h5");
@@ -76,7 +104,7 @@ fn a_version_1_elastic_case_drops_its_zero_plastic_columns() {
     let dir = workdir("v1-elastic");
     std::fs::copy(data("v1-cantilever.h5"), dir.join("c.h5")).unwrap();
     ok(&dir, 1, &["c.h5", "--out", "run"]);
-    // Step 1 is the version-1 program's bit for bit. Step 2 starts from a mesh whose boundary
+    // Step 1 is the version-1 program's (to 1e-12). Step 2 starts from a mesh whose boundary
     // edges keep the curve the beam's bending gave them in step 1 (`mesh.curved_edges`, newer
     // than version 1): it moved the tip by 3e-4 of its version-1 value, towards the exact one.
     let (got, want) = (
@@ -86,11 +114,9 @@ fn a_version_1_elastic_case_drops_its_zero_plastic_columns() {
     let lines = |t: &str| t.lines().map(str::to_string).collect::<Vec<_>>();
     let (got, want) = (lines(&got), lines(&want));
     assert_eq!(got.len(), 3, "{got:?}");
-    assert_eq!(got[..2], want[..2]);
-    let values = |l: &str| -> Vec<f64> { l.split(',').map(|x| x.parse().unwrap()).collect() };
-    for (a, b) in values(&got[2]).iter().zip(values(&want[2])) {
-        assert!((a - b).abs() <= 1e-3 * b.abs(), "step 2: {a} against {b}");
-    }
+    assert_same_line(&got[0], &want[0], 0.0, "header");
+    assert_same_line(&got[1], &want[1], 1e-12, "step 1");
+    assert_same_line(&got[2], &want[2], 1e-3, "step 2");
     let cp = dir.join("run/checkpoints/step_000002.h5");
     assert_eq!(h5_attr(&cp, "f['particles/state'].shape[1]"), "4");
     assert_eq!(h5_attr(&cp, "f['gauss/state'].shape[1]"), "12");
