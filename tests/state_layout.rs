@@ -1,9 +1,9 @@
 //! The material state as each model lays it out: version-1 case files (nine state columns for
-//! every model, no `names`) load and continue as that program did; new files are as wide as the model's
-//! layout and name their columns; the field output carries one field per internal variable.
-//! "Bit for bit" is to 1e-12 of each value: the direct solver's libraries (MUMPS, BLAS) of
-//! another build round the last digit differently (4e-15 between two Debian installs), while a
-//! misread state column moves the history by far more.
+//! every model, no `names`) load and continue as that program did; new files are as wide as the
+//! model's layout and name their columns; the field output carries one field per internal
+//! variable. "As that program did" is to 1e-12 of each value: the direct solver's libraries
+//! (MUMPS, BLAS) of another build round the last digit differently (4e-15 between two Debian
+//! installs), while a misread state column moves the history by far more.
 //!
 //! `tests/data/v1-*` were written by pfem-mpi at bcc2ea4 (format version 1), with the histories
 //! that binary produced from them on 1 rank:
