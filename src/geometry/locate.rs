@@ -52,26 +52,30 @@ impl Locator {
 /// The segments `locate` tests at `p`: those of the (sub)cell it ends in.
 #[cfg(test)]
 pub(super) fn locate_work(locator: &Locator, p: Point) -> usize {
-    let (mut grid, mut table) = (&locator.grid, &locator.table);
-    if !(p[0].is_finite() && p[1].is_finite() && grid.inside_grid(p)) {
+    if !(p[0].is_finite() && p[1].is_finite() && locator.grid.inside_grid(p)) {
         return 0;
     }
-    loop {
-        let (i, j) = grid.cell_of(p);
-        let c = j * grid.dims().0 + i;
-        match (grid.sub(i, j), table.subs.get(&c)) {
-            (Some(sub), Some(sub_table)) => (grid, table) = (&sub.grid, sub_table),
-            _ => return grid.cell_items(i, j).len(),
-        }
+    let (grid, _, i, j) = leaf(&locator.grid, &locator.table, p);
+    grid.cell_items(i, j).len()
+}
+
+/// The finest grid holding `p`, its table and `p`'s cell there.
+fn leaf<'a>(
+    grid: &'a EdgeGrid,
+    table: &'a RefTable,
+    p: Point,
+) -> (&'a EdgeGrid, &'a RefTable, usize, usize) {
+    let (i, j) = grid.cell_of(p);
+    let c = j * grid.dims().0 + i;
+    match (grid.sub(i, j), table.subs.get(&c)) {
+        (Some(sub), Some(sub_table)) => leaf(&sub.grid, sub_table, p),
+        _ => (grid, table, i, j),
     }
 }
 
 fn locate_in(grid: &EdgeGrid, table: &RefTable, p: Point) -> Location {
-    let (i, j) = grid.cell_of(p);
+    let (grid, table, i, j) = leaf(grid, table, p);
     let c = j * grid.dims().0 + i;
-    if let (Some(sub), Some(sub_table)) = (grid.sub(i, j), table.subs.get(&c)) {
-        return locate_in(&sub.grid, sub_table, p);
-    }
     let items = grid.cell_items(i, j);
     let segs = grid.segments();
     if items.iter().any(|&s| {
