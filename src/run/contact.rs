@@ -56,10 +56,9 @@ impl Simulation {
             .enumerate()
             .map(|(i, e)| ((e[0], e[1]), (n_vertex + i) as u32))
             .collect();
-        // Boundary edges with their nodes [a, m, b] and start length.
-        // (nodes, the nodes' positions [a, mid, b], the nodes' weights, spacing) of every
-        // boundary edge.
-        type Edge = ([u32; 3], [[f64; 2]; 3], [f64; 3], f64);
+        // (nodes [a, m, b], the nodes' positions, the nodes' weights, spacing, whether it lies
+        // on a sliding support) of every boundary edge.
+        type Edge = ([u32; 3], [[f64; 2]; 3], [f64; 3], f64, bool);
         let mut edges: Vec<Edge> = Vec::new();
         let analysis = model.scene.analysis;
         for e in &mesh.boundary_edges {
@@ -88,11 +87,18 @@ impl Simulation {
                 ring(mid) * simpson[1],
                 ring(xb) * simpson[2],
             ];
+            let on_support = along_support(
+                |n, c| constraints.is_fixed(n as usize, c),
+                [na, m, nb],
+                xa,
+                xb,
+            );
             edges.push((
                 [na, m, nb],
                 [xa, mid, xb],
                 weights,
                 mesh.h[a as usize].max(mesh.h[b as usize]),
+                on_support,
             ));
             for (k, sp) in model.scene.surface_pressure.iter().enumerate() {
                 let inside = |p: u32| {
@@ -138,8 +144,8 @@ impl Simulation {
                     || x[1] > bb[1][1] + margin;
                 !outside_box && shape.closest(*x).distance <= margin
             };
-            for (nodes, xs, weights, h) in &edges {
-                if !near(&xs[1], *h) {
+            for (nodes, xs, weights, h, on_support) in &edges {
+                if *on_support || !near(&xs[1], *h) {
                     continue;
                 }
                 for (node, wk) in nodes.iter().zip(weights) {
@@ -149,7 +155,7 @@ impl Simulation {
             // A node near the body on no such edge (under a cone's tip, where the midpoints of
             // the edges beside it are still far off) stands for its own share of its edges.
             let mut tips: HashMap<u32, f64> = HashMap::new();
-            for (nodes, xs, weights, h) in &edges {
+            for (nodes, xs, weights, h, _) in edges.iter().filter(|e| !e.4) {
                 for k in [0, 2] {
                     if !weight.contains_key(&nodes[k]) && near(&xs[k], *h) {
                         *tips.entry(nodes[k]).or_default() += weights[k];
@@ -345,6 +351,23 @@ impl Simulation {
     }
 }
 
+/// Whether the boundary edge with nodes `nodes` from `xa` to `xb` runs along a support that holds
+/// all three nodes across it (`fixed(node, component)`): the axis of revolution, a symmetry
+/// plane. Such an edge is a cut through the soil, not its surface, and never touches a body.
+/// Counted as contact surface, the axis below a spudcan's tip made an axis node 0.4 m under the
+/// tip, within the search margin of the edge's midpoint, a contact node, and Newton pulled it up
+/// through the soil to close its "gap" (directions of 0.2-1.0 m against the body's 0.1 m a step,
+/// inverting the triangles between).
+fn along_support(
+    fixed: impl Fn(u32, usize) -> bool,
+    nodes: [u32; 3],
+    xa: [f64; 2],
+    xb: [f64; 2],
+) -> bool {
+    let len = (xb[0] - xa[0]).hypot(xb[1] - xa[1]);
+    (0..2).any(|c| nodes.iter().all(|&n| fixed(n, c)) && (xb[c] - xa[c]).abs() <= 1e-9 * len)
+}
+
 /// Start position, spacing and global key of local node `n`.
 fn node_info(
     mesh: &LocalMesh,
@@ -364,5 +387,25 @@ fn node_info(
             mesh.h[a].max(mesh.h[b]),
             edge_key(mesh.gids[a], mesh.gids[b]),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::along_support;
+
+    #[test]
+    fn only_edges_along_a_support_that_holds_them_across_are_cuts() {
+        // Nodes 0-2 held in x (on the axis), node 3 free.
+        let fixed = |n: u32, c: usize| c == 0 && n < 3;
+        assert!(along_support(fixed, [0, 1, 2], [0.0, 1.0], [0.0, 1.5]));
+        // Off the axis at one end: a surface, though its nodes are held.
+        assert!(!along_support(fixed, [0, 1, 2], [0.0, 1.0], [0.1, 1.5]));
+        // One node free: a surface.
+        assert!(!along_support(fixed, [0, 3, 2], [0.0, 1.0], [0.0, 1.5]));
+        // A symmetry plane y = const held in y.
+        let held_y = |_: u32, c: usize| c == 1;
+        assert!(along_support(held_y, [4, 5, 6], [0.2, 0.0], [0.7, 0.0]));
+        assert!(!along_support(held_y, [4, 5, 6], [0.2, 0.0], [0.7, 0.3]));
     }
 }
