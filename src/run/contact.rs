@@ -56,8 +56,8 @@ impl Simulation {
             .enumerate()
             .map(|(i, e)| ((e[0], e[1]), (n_vertex + i) as u32))
             .collect();
-        // (nodes [a, m, b], the nodes' positions, the nodes' weights, spacing, whether it lies
-        // on a sliding support) of every boundary edge.
+        // (nodes [a, m, b], the nodes' positions, the nodes' weights, spacing, whether it runs
+        // along a support, `along_support`) of every boundary edge.
         type Edge = ([u32; 3], [[f64; 2]; 3], [f64; 3], f64, bool);
         let mut edges: Vec<Edge> = Vec::new();
         let analysis = model.scene.analysis;

@@ -199,8 +199,8 @@ impl Simulation {
         }
         // Boundary edges of the new mesh with a recorded curve: every rank's, so that an edge
         // of a triangle this rank holds whose particles are both ghosts is known as well.
-        // Edges without one that cut into a body deeper than a recorded curve would have to
-        // (`DEEP_CHORD`) are fitted to its surface instead.
+        // An edge without one whose chord cuts into a body by `DEEP_CHORD` of the spacing or
+        // more (the depth from which curves on bodies are recorded) is fitted to its surface.
         let lambda = self.header.load_factor;
         let shapes: Vec<_> = self.model.bodies.iter().map(|b| b.shape(lambda)).collect();
         let index: HashMap<u64, u32> = mesh
@@ -214,7 +214,7 @@ impl Simulation {
             if shapes.is_empty() {
                 return None;
             }
-            let (a, b) = (index[&key[0]] as usize, index[&key[1]] as usize);
+            let (a, b) = (*index.get(&key[0])? as usize, *index.get(&key[1])? as usize);
             let h = mesh.h[a].max(mesh.h[b]);
             onto_surface(&shapes, mesh.points[a], mesh.points[b], DEEP_CHORD * h)
         };
