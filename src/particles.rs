@@ -43,17 +43,24 @@ impl Particles {
     /// radially. Off it, its triangles are slivers whose hoop stretch 1 + u_r/r Newton drives
     /// through zero: on the spudcan a particle under the tip crept 0.057 → 0.040 → 0.020 →
     /// 0.005 m (h = 0.5 m) towards the axis in four steps, and Newton then crawled (line search
-    /// λ ≈ 0.006) and failed in the fifth. Returns how many were moved.
-    pub fn snap_to_axis(&mut self) -> usize {
+    /// λ ≈ 0.006) and failed in the fifth. `onto(x, h)` says where on the axis a particle whose
+    /// place there is `x` goes (`x`, or along the axis out of a rigid body it lies in), `None` to
+    /// leave it off the axis. Returns how many were moved.
+    pub fn snap_to_axis(&mut self, onto: impl Fn([f64; 2], f64) -> Option<[f64; 2]>) -> usize {
         let mut moved = 0;
         for i in 0..self.position.len() {
-            let x = self.position[i][0];
-            if x != 0.0 && x < AXIS_SNAP * self.h[i] {
-                self.position[i][0] = 0.0;
-                self.displacement[i][0] -= x;
-                self.increment[i][0] = 0.0;
-                moved += 1;
+            let x = self.position[i];
+            if x[0] == 0.0 || x[0] >= AXIS_SNAP * self.h[i] {
+                continue;
             }
+            let Some(to) = onto([0.0, x[1]], self.h[i]) else {
+                continue;
+            };
+            self.position[i] = [0.0, to[1]];
+            self.displacement[i][0] -= x[0];
+            self.displacement[i][1] += to[1] - x[1];
+            self.increment[i][0] = 0.0;
+            moved += 1;
         }
         moved
     }
@@ -187,7 +194,7 @@ mod tests {
         let reference: Vec<f64> = (0..4)
             .map(|i| p.position[i][0] - p.displacement[i][0])
             .collect();
-        assert_eq!(p.snap_to_axis(), 2);
+        assert_eq!(p.snap_to_axis(|x, _| Some(x)), 2);
         assert_eq!(p.position[0], [0.0, 1.0]);
         assert_eq!(p.position[1], [0.3, 2.0], "0.6 h off the axis stays");
         assert_eq!(p.position[2], [0.0, 3.0]);
@@ -201,5 +208,18 @@ mod tests {
         for (i, r) in reference.iter().enumerate() {
             assert!((p.position[i][0] - p.displacement[i][0] - r).abs() < 1e-15);
         }
+        // Moved along the axis where `onto` says, or left off it.
+        p.position[0] = [0.1, 1.0];
+        p.position[2] = [0.1, 0.5];
+        let before = p.displacement[0];
+        let onto = |x: [f64; 2], _| (x[1] < 0.9).then_some(x).or(Some([0.0, 0.8]));
+        assert_eq!(p.snap_to_axis(onto), 2);
+        assert_eq!(p.position[0], [0.0, 0.8]);
+        let d = p.displacement[0];
+        assert!((d[0] - before[0] + 0.1).abs() < 1e-15 && (d[1] - before[1] + 0.2).abs() < 1e-15);
+        assert_eq!(p.position[2], [0.0, 0.5]);
+        p.position[0] = [0.1, 1.0];
+        assert_eq!(p.snap_to_axis(|_, _| None), 0);
+        assert_eq!(p.position[0], [0.1, 1.0]);
     }
 }

@@ -1,6 +1,7 @@
 //! The PFEM step loop (the method's Fig. 1): remesh, map, solve, update, output, checkpoint.
 
 mod adapt;
+mod axis;
 mod boundary_rules;
 mod contact;
 mod curved_edges;

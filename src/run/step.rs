@@ -750,7 +750,9 @@ impl Simulation {
             self.particles.increment[i] = [per_step * d[0], per_step * d[1]];
         }
         if self.model.scene.analysis.has_hoop() {
-            self.particles.snap_to_axis();
+            let bodies: Vec<_> = self.model.bodies.iter().map(|b| b.shape(to)).collect();
+            self.particles
+                .snap_to_axis(|x, h| super::axis::out_of_bodies(&bodies, x, h));
         }
         let last = (0..solved.dofs.n_nodes()).map(|n| {
             let d = solved.du[n];
