@@ -11,6 +11,35 @@ pub use body::RigidBody;
 pub use contact::{node_law, ContactPair, NodeLaw, Status};
 pub use shape::{Proximity, Shape};
 
+/// The proximity of `x` to the body it lies deepest in, or nearest to (smallest signed
+/// distance); `None` without bodies.
+pub fn nearest(shapes: &[Shape], x: [f64; 2]) -> Option<Proximity> {
+    shapes
+        .iter()
+        .map(|s| s.closest(x))
+        .min_by(|p, q| p.distance.total_cmp(&q.distance))
+}
+
+/// The signed distance from `x` to the nearest body (negative inside; infinite without bodies).
+pub fn gap(shapes: &[Shape], x: [f64; 2]) -> f64 {
+    nearest(shapes, x).map_or(f64::INFINITY, |p| p.distance)
+}
+
+/// Where a path t ↦ x(t) leaves the bodies, by bisection between `inside` (a parameter where it
+/// is inside) and `outside` (one where it is out), `out_at(t)` telling which: the last
+/// parameter found outside, within 2⁻⁴⁰ of the bracket.
+pub fn exit(mut inside: f64, mut outside: f64, out_at: impl Fn(f64) -> bool) -> f64 {
+    for _ in 0..40 {
+        let half = 0.5 * (inside + outside);
+        if out_at(half) {
+            outside = half;
+        } else {
+            inside = half;
+        }
+    }
+    outside
+}
+
 /// A triangle reaching deeper than this fraction of its spacing (or of the body's inradius)
 /// into a rigid body crosses it.
 pub const CROSSING_DEPTH: f64 = 0.25;
@@ -53,6 +82,20 @@ fn centroid(t: [[f64; 2]; 3]) -> [f64; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn nearest_picks_the_deepest_body_and_exit_finds_its_surface() {
+        let bodies = [
+            Shape::circle([0.0, 0.0], 1.0).unwrap(),
+            Shape::circle([3.0, 0.0], 1.0).unwrap(),
+        ];
+        let p = nearest(&bodies, [2.5, 0.0]).unwrap();
+        assert!((p.distance + 0.5).abs() < 1e-15 && p.normal[0] < 0.0);
+        assert_eq!(gap(&[], [0.0, 0.0]), f64::INFINITY);
+        // Along the x axis from the first circle's centre outwards: leaves it at x = 1.
+        let t = exit(0.0, 1.7, |x| gap(&bodies, [x, 0.0]) >= 0.0);
+        assert!(t >= 1.0 && t - 1.0 < 1e-11, "{t}");
+    }
     use crate::mesh::LocalMesh;
 
     /// A 21 × 21 lattice of spacing 0.05 meshed whole, then the triangles crossing `shape`

@@ -1,7 +1,7 @@
 //! Where a particle put on the axis of revolution goes when its place there lies inside a rigid
 //! body of revolution (`Particles::snap_to_axis`).
 
-use crate::rigid::Shape;
+use crate::rigid::{exit, gap, nearest, Shape};
 
 /// `x` (on the axis) if it lies outside every body in `bodies`; else the point where the axis
 /// leaves the body it lies in, found along the axis in the direction the body's nearest surface
@@ -12,33 +12,19 @@ use crate::rigid::Shape;
 /// step ended the run as soil inside the body. Left off the axis instead, such particles under
 /// the `spudcan`'s tip crept towards it and Newton stalled at z/D = 0.05.
 pub(super) fn out_of_bodies(bodies: &[Shape], x: [f64; 2], h: f64) -> Option<[f64; 2]> {
-    let depth = |y: f64| {
-        bodies
-            .iter()
-            .map(|s| s.closest([0.0, y]))
-            .min_by(|a, b| a.distance.total_cmp(&b.distance))
-    };
-    let Some(here) = depth(x[1]) else {
+    let Some(here) = nearest(bodies, x) else {
         return Some(x);
     };
     if here.distance >= 0.0 {
         return Some(x);
     }
     let dir = if here.normal[1] >= 0.0 { 1.0 } else { -1.0 };
+    let outside = |y: f64| gap(bodies, [0.0, y]) >= 0.0;
     let far = x[1] + dir * h;
-    if depth(far)?.distance < 0.0 {
+    if !outside(far) {
         return None;
     }
-    let (mut inside, mut outside) = (x[1], far);
-    for _ in 0..60 {
-        let mid = 0.5 * (inside + outside);
-        if depth(mid)?.distance >= 0.0 {
-            outside = mid;
-        } else {
-            inside = mid;
-        }
-    }
-    Some([0.0, outside])
+    Some([0.0, exit(x[1], far, outside)])
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@ use super::step::edge_key;
 use super::Simulation;
 use crate::mesh::curved::{bulge, keeps_shape, midside, MAX_BULGE, MIN_BULGE};
 use crate::mesh::LocalMesh;
+use crate::rigid::{exit, gap, nearest};
 use crate::solve::DofMap;
 use pfem_partition::{allgather_u64, Comm};
 use std::collections::{HashMap, HashSet};
@@ -47,13 +48,7 @@ pub(super) fn gather(world: &Comm, local: &[([u64; 2], f64)]) -> Bulges {
 /// a node left inside would stay inside, the contact holding it at its starting depth. Only
 /// positions decide, so every rank finds the same.
 fn outside_bodies(shapes: &[crate::rigid::Shape], a: [f64; 2], b: [f64; 2], s: f64) -> f64 {
-    let depth = |s: f64| {
-        let m = midside(a, b, s);
-        shapes
-            .iter()
-            .map(|shape| shape.closest(m).distance)
-            .fold(f64::INFINITY, f64::min)
-    };
+    let depth = |s: f64| gap(shapes, midside(a, b, s));
     if depth(s) >= 0.0 {
         return s;
     }
@@ -62,16 +57,7 @@ fn outside_bodies(shapes: &[crate::rigid::Shape], a: [f64; 2], b: [f64; 2], s: f
         return if depth(0.0) >= depth(s) { 0.0 } else { s };
     }
     // Out at 0, in at s: the crossing, from the outside.
-    let (mut out, mut inside) = (0.0, s);
-    for _ in 0..40 {
-        let half = 0.5 * (out + inside);
-        if depth(half) >= 0.0 {
-            out = half;
-        } else {
-            inside = half;
-        }
-    }
-    out
+    exit(s, 0.0, |t| depth(t) >= 0.0)
 }
 
 /// The curve that puts the midside node of chord `a`→`b` (key order) on the surface of the
@@ -88,14 +74,7 @@ fn onto_surface(
     b: [f64; 2],
     min_depth: f64,
 ) -> Option<f64> {
-    let depth = |s: f64| {
-        let m = midside(a, b, s);
-        shapes
-            .iter()
-            .map(|shape| shape.closest(m))
-            .min_by(|p, q| p.distance.total_cmp(&q.distance))
-    };
-    let start = depth(0.0)?;
+    let start = nearest(shapes, midside(a, b, 0.0))?;
     if start.distance > -min_depth {
         return None;
     }
@@ -103,19 +82,11 @@ fn onto_surface(
     let d = [b[0] - a[0], b[1] - a[1]];
     let out = start.normal[0] * d[1] - start.normal[1] * d[0];
     let far = MAX_BULGE.copysign(out);
-    if depth(far)?.distance < 0.0 {
+    let outside = |t: f64| gap(shapes, midside(a, b, t)) >= 0.0;
+    if !outside(far) {
         return Some(far);
     }
-    let (mut inside, mut outside) = (0.0, far);
-    for _ in 0..40 {
-        let half = 0.5 * (inside + outside);
-        if depth(half)?.distance >= 0.0 {
-            outside = half;
-        } else {
-            inside = half;
-        }
-    }
-    Some(outside)
+    Some(exit(0.0, far, outside))
 }
 
 /// Sorted gid keys of the boundary edges of `mesh` that touch an owned particle.

@@ -55,12 +55,7 @@ impl Simulation {
         let lambda = self.header.load_factor;
         let bodies: Vec<_> = self.model.bodies.iter().map(|b| b.shape(lambda)).collect();
         // Signed distance to the nearest body (negative inside; infinite without bodies).
-        let gap = |x: [f64; 2]| {
-            bodies
-                .iter()
-                .map(|s| s.closest(x).distance)
-                .fold(f64::INFINITY, f64::min)
-        };
+        let gap = |x: [f64; 2]| crate::rigid::gap(&bodies, x);
         let slides = |p: usize| gap(mesh.points[p]) <= SLIDING_GAP * mesh.h[p];
         // A particle held in one direction only (a symmetry plane) near a body: its distance
         // to the body. Read for ghosts too, from their reference positions, as every rank
