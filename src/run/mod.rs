@@ -20,6 +20,7 @@ mod signals;
 mod simulation;
 mod step;
 mod step_solver;
+mod support_plane;
 mod terminal;
 mod test_hooks;
 
