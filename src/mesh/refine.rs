@@ -158,9 +158,9 @@ pub fn plan(
                 // Of two crowded neighbours on the support the one farther from the body goes
                 // (the larger id on a tie), near the body or not: the flow ahead of a body
                 // compresses the plane's particles beyond the merge distance from it too, and
-                // held ones never merge otherwise (the softening T-bar's 7th stroke: seven
-                // particles within 8 mm of the plane below the bar, two 4e-6 m apart, and the
-                // sliver between them stopped Newton). Away from the body only where the edge
+                // held ones never merge otherwise (the softening T-bar's 7th stroke: eight
+                // held particles within 8 mm below the bar, two 3.7e-6 m apart, and the sliver
+                // between them stopped Newton). Away from the body only where the edge
                 // that replaces its two stays on the outline: a corner of the body (the top of
                 // a symmetry plane) keeps its shape.
                 let before = |q: u32| {
