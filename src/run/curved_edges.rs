@@ -24,6 +24,11 @@ const ON_BODY: f64 = 0.01;
 /// bench/VALIDATION.md); free surfaces keep every curve.
 const DEEP_CHORD: f64 = 0.05;
 
+/// The least turn (radians) of a body's surface between the ends of a chord that makes it a
+/// chord across a corner (`onto_surface`): the spudcan's rim turns 77°, a chord of the split
+/// length on the default T-bar's face 23°.
+const MIN_CORNER_TURN: f64 = std::f64::consts::FRAC_PI_4;
+
 /// Relative midside offset ([`bulge`]) per boundary edge, by sorted gid pair, sorted.
 pub(super) type Bulges = Vec<([u64; 2], f64)>;
 
@@ -76,6 +81,14 @@ fn onto_surface(
 ) -> Option<f64> {
     let start = nearest(shapes, midside(a, b, 0.0))?;
     if start.distance > -min_depth {
+        return None;
+    }
+    // Only across a corner: on a smooth face a chord dips in by its sagitta L²/8R, which the
+    // contact's start offset tolerates, and bending the default T-bar's chords of 1.3–1.6
+    // spacings (0.05–0.08 spacing deep, the face turning 20–23° along them) onto its face made
+    // its load fall 10 % from w/D = 1.25 on.
+    let (na, nb) = (nearest(shapes, a)?.normal, nearest(shapes, b)?.normal);
+    if na[0] * nb[0] + na[1] * nb[1] > MIN_CORNER_TURN.cos() {
         return None;
     }
     // The offset direction (the chord's right-hand normal, `midside`) that leads out.
@@ -276,9 +289,18 @@ mod tests {
         assert_eq!(onto_surface(&circle, a, b, 0.2), None);
         assert_eq!(onto_surface(&circle, [-0.5, 1.2], [0.5, 1.2], 0.0), None);
         assert_eq!(onto_surface(&[], a, b, 0.0), None);
-        // A short chord deep inside bends as far as a P2 edge may, and no further.
-        let s = onto_surface(&circle, [-0.1, 0.5], [0.1, 0.5], 0.05).unwrap();
+        // A short chord deep inside a corner bends as far as a P2 edge may, and no further.
+        let square =
+            [Shape::polygon(&[[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]], 0.0).unwrap()];
+        let (a, b) = ([0.6, 0.9], [0.9, 0.6]);
+        let s = onto_surface(&square, a, b, 0.05).unwrap();
         assert_eq!(s.abs(), MAX_BULGE);
-        assert!(midside([-0.1, 0.5], [0.1, 0.5], s)[1] > 0.5);
+        let m = midside(a, b, s);
+        assert!(m[0] + m[1] > 1.5, "{m:?}");
+        // Along a smooth face (radius 4, a chord of 1.6 turning 23°, 0.08 deep): left straight.
+        let big = [Shape::circle([0.0, 0.0], 4.0).unwrap()];
+        let (a, b) = ([-0.8, 3.919], [0.8, 3.919]);
+        assert!(gap(&big, midside(a, b, 0.0)) < -0.05);
+        assert_eq!(onto_surface(&big, a, b, 0.05), None);
     }
 }
