@@ -203,8 +203,9 @@ impl Scene {
     /// The complete scene, defaults included, as TOML. [`Scene::from_toml`] reads it back to an
     /// equal scene (floats are written in shortest round-trip form).
     pub fn to_toml(&self) -> String {
-        // toml refuses only shapes a Scene never has (bare None, non-string keys, integers
-        // beyond i64): every field is a string, f64, u32, bool, array or table.
+        // toml refuses only a None outside a table, a unit value, an invalid date, a non-string
+        // key and an integer beyond i64. A Scene has none: each Option is a table field (skipped
+        // when None), each key a field name, and its usize fields were read from TOML integers.
         toml::to_string(self).expect("a Scene always has a TOML representation")
     }
 
