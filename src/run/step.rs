@@ -826,13 +826,19 @@ impl Simulation {
     }
 }
 
-/// Halvings of a step's increment before a Newton failure is final.
+/// Halvings of a step's increment before a Newton failure is final: the smallest piece is
+/// 1/2⁶ of the step. The budget is the piece's size, not a count of the step's cuts: a step
+/// with several hard places (a contact node reaching a corner, then another) cuts at each and
+/// grows back in between, and a count over the whole step ended such steps on pieces of 1/8
+/// (the coarse `cpt-trial` at z/D = 3.1, the `spudcan` at z/D = 0.11, bench/VALIDATION.md).
+/// Every converged piece advances by at least the smallest, so a step ends after at most
+/// 2⁶ converged pieces.
 pub(super) const MAX_CUTS: usize = 6;
 
 impl Simulation {
     /// Collective. Solves the next step on `mesh` and moves the particles. When Newton diverges,
     /// the piece is tried once more with the other line search (full steps or backtracking),
-    /// then the rest of the step is cut in half (up to 6 times, growing back after each success), each
+    /// then cut in half (down to 1/2⁶ of the step, growing back after each success), each
     /// piece a full remesh–map–solve–update cycle; `mesh` ends as the mesh of the last piece.
     pub fn advance(
         &mut self,
@@ -849,11 +855,12 @@ impl Simulation {
         let (mut cuts, mut newton, mut linear, mut remapped) = (0, 0, 0, 0);
         let steps = self.model.scene.steps;
         // Under `until_collapse` a failure is cut until it brackets the collapse load factor.
-        let may_cut = |cuts: usize, piece: f64| {
+        let smallest = full / (1u64 << MAX_CUTS) as f64;
+        let may_cut = |piece: f64| {
             if steps.until_collapse {
                 piece > steps.collapse_tolerance
             } else {
-                cuts < MAX_CUTS
+                piece > 1.5 * smallest
             }
         };
         let mut converged_pieces = false;
@@ -873,7 +880,7 @@ impl Simulation {
                     self.alternate_search.set(false);
                     newton += solved.newton_iterations;
                     linear += solved.linear_iterations;
-                    if may_cut(cuts, piece) {
+                    if may_cut(piece) {
                         cuts += 1;
                         piece *= 0.5;
                     } else {
@@ -917,7 +924,7 @@ impl Simulation {
                     self.alternate_search.set(true);
                 }
                 Err(SolveError::Diverged(_) | SolveError::ContactUnsettled(_))
-                    if may_cut(cuts, piece) =>
+                    if may_cut(piece) =>
                 {
                     self.alternate_search.set(false);
                     cuts += 1;

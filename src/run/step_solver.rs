@@ -11,7 +11,8 @@ pub struct StepSolver {
     pub retry: &'static str,
     /// Contact with rigid bodies, when there are any: decided inside every Newton iteration.
     pub contact: Option<ContactMethod>,
-    /// Halvings of a step's increment before a divergence is final.
+    /// Halvings of a step's increment before a divergence is final: the smallest piece is
+    /// 1/2^max_cuts of the step (a converged piece lets the next grow back).
     pub max_cuts: usize,
 }
 
@@ -62,8 +63,11 @@ impl std::fmt::Display for StepSolver {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "Newton, line search {} (a diverged piece retried with {}, then halved up to {} times)",
-            self.line_search, self.retry, self.max_cuts
+            "Newton, line search {} (a diverged piece retried with {}, then halved down to 1/{} \
+             of the step)",
+            self.line_search,
+            self.retry,
+            1u64 << self.max_cuts
         )?;
         if let Some(c) = self.contact {
             write!(
