@@ -91,3 +91,38 @@ fn diverging_steps_are_cut_and_recovered() {
     println!("cut run differs from the plain run by {rel:.2e} in v/L at lambda = 10");
     assert!(rel < 1e-3, "{rel}");
 }
+
+/// The cut budget is the piece's size, not a count over the step: the whole load in one step,
+/// with Newton held to 4 iterations, needs pieces down to a small fraction of the step again and
+/// again as the cantilever bends (measured: 26 cuts), and completes where a budget of six cuts a
+/// step stopped it.
+#[test]
+fn a_step_cut_at_many_places_completes() {
+    let dir = workdir("cantilever-many-cuts");
+    small_cantilever(&dir, 10, &[]);
+    ok(&dir, 1, &["c.h5", "--out", "plain"]);
+    small_cantilever(&dir, 1, &[]);
+    let log = ok(
+        &dir,
+        1,
+        &[
+            "c.h5",
+            "--out",
+            "one",
+            "--progress",
+            "json",
+            "--",
+            "-snes_max_it",
+            "4",
+        ],
+    );
+    let steps = json_steps(&log);
+    assert_eq!(steps.len(), 1);
+    let cuts = steps[0]["cuts"].as_u64().unwrap_or(0);
+    assert!(cuts > 6, "one step of the whole load should cut often: {cuts}");
+    let (_, plain) = history(&dir.join("plain/history.csv"));
+    let (_, one) = history(&dir.join("one/history.csv"));
+    let rel = ((one[0][3] - plain[9][3]) / plain[9][3]).abs();
+    println!("{cuts} cuts; v/L differs from 10 steps by {rel:.2e}");
+    assert!(rel < 1e-3, "{rel}");
+}
