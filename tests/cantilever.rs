@@ -119,7 +119,10 @@ fn a_step_cut_at_many_places_completes() {
     let steps = json_steps(&log);
     assert_eq!(steps.len(), 1);
     let cuts = steps[0]["cuts"].as_u64().unwrap_or(0);
-    assert!(cuts > 6, "one step of the whole load should cut often: {cuts}");
+    assert!(
+        cuts > 6,
+        "one step of the whole load should cut often: {cuts}"
+    );
     let (_, plain) = history(&dir.join("plain/history.csv"));
     let (_, one) = history(&dir.join("one/history.csv"));
     let rel = ((one[0][3] - plain[9][3]) / plain[9][3]).abs();
