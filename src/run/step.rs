@@ -749,12 +749,19 @@ impl Simulation {
             }
             self.particles.increment[i] = [per_step * d[0], per_step * d[1]];
         }
-        let bodies: Vec<_> = self.model.bodies.iter().map(|b| b.shape(to)).collect();
-        for plane in super::support_plane::support_planes(&self.model.scene.fixed) {
+        let planes = super::support_plane::support_planes(&self.model.scene.fixed);
+        let hoop = self.model.scene.analysis.has_hoop();
+        // The bodies at the step's end, built only for a scene that puts particles back.
+        let bodies: Vec<_> = if planes.is_empty() && !hoop {
+            Vec::new()
+        } else {
+            self.model.bodies.iter().map(|b| b.shape(to)).collect()
+        };
+        for plane in planes {
             let outside = |x: [f64; 2]| crate::rigid::gap(&bodies, x) >= 0.0;
             plane.put_back(&mut self.particles, self.model.tol, outside);
         }
-        if self.model.scene.analysis.has_hoop() {
+        if hoop {
             self.particles
                 .snap_to_axis(|x, h| super::axis::out_of_bodies(&bodies, x, h));
         }
