@@ -323,6 +323,36 @@ impl Model {
         step as f64 / self.scene.steps.count as f64
     }
 
+    /// How far the last step's increment, kept per whole step, goes towards the increment
+    /// from load factor `from` to `to`: the pieces' ratio `(to − from) · steps`, times the
+    /// projection of the rigid bodies' motion now onto their motion just before `from`. Where a
+    /// stage reverses a body (a cycled T-bar) the last increment points the wrong way: scaled
+    /// by +1 it started the softening T-bar's first step down with the clay under the bar
+    /// 0.74 mm (0.15 spacing) inside it, and no piece down to 1/64 of the step converged
+    /// (bench/VALIDATION.md, fourteenth session); where a stage turns a body (the pipeline's
+    /// lateral stage) it is no guess at all. Within a stage the projection is 1; with no body
+    /// moving, proportional loading keeps the plain ratio.
+    pub fn predictor_scale(&self, from: f64, to: f64) -> f64 {
+        let steps = self.scene.steps.count as f64;
+        let ratio = (to - from) * steps;
+        // Pieces are at least 1/64 of a step and a stage changes only at a step's end, so the
+        // last 1/64 of a step before `from` moved like the last increment did.
+        let back = 1.0 / (64.0 * steps);
+        let (mut along, mut last) = (0.0, 0.0);
+        for b in &self.bodies {
+            let [a, c, d] = [from - back, from, to].map(|l| b.displacement(l));
+            let before = [(c[0] - a[0]) / back, (c[1] - a[1]) / back];
+            let now = [(d[0] - c[0]) / (to - from), (d[1] - c[1]) / (to - from)];
+            along += before[0] * now[0] + before[1] * now[1];
+            last += before[0] * before[0] + before[1] * before[1];
+        }
+        if from - back < 0.0 || last == 0.0 {
+            ratio
+        } else {
+            ratio * along / last
+        }
+    }
+
     /// Prescribed displacement increment, from load factor `from` to `to`, of a particle at
     /// reference position `x0` and current position `x`.
     pub fn step_bc(&self, x0: [f64; 2], x: [f64; 2], from: f64, to: f64) -> [Option<f64>; 2] {
@@ -420,6 +450,55 @@ fn face(p: &Prescribed, c: usize) -> f64 {
 mod tests {
     use super::*;
     use crate::scene::load_scene;
+
+    #[test]
+    fn predictor_follows_the_bodies_motion_across_stages() {
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-9 * b.abs().max(1.0);
+        // 120 steps down, then 240 up, 240 down, ...: 4 920 steps.
+        let (scene, _) = load_scene("tbar-softening", &[]).unwrap();
+        let model = Model::new(&scene).unwrap();
+        let full = 1.0 / 4920.0;
+        let at = |step: f64| step * full;
+        assert!(
+            close(model.predictor_scale(at(0.0), at(1.0)), 1.0),
+            "first step"
+        );
+        assert!(
+            close(model.predictor_scale(at(5.0), at(6.0)), 1.0),
+            "within a stage"
+        );
+        assert!(
+            close(model.predictor_scale(at(5.0), at(5.25)), 0.25),
+            "a piece"
+        );
+        // The second stage goes up at half the first's speed per step: 0.06 m in 240 steps
+        // against 0.06 m in 120; the third down at 0.12 m in 240.
+        assert!(
+            close(model.predictor_scale(at(120.0), at(121.0)), -0.5),
+            "reversal"
+        );
+        assert!(
+            close(model.predictor_scale(at(120.5), at(121.0)), 0.5),
+            "piece after it"
+        );
+        assert!(
+            close(model.predictor_scale(at(360.0), at(360.5)), -1.0),
+            "next reversal"
+        );
+        // The pipeline turns from vertical (0.02 m in 50 steps) to lateral.
+        let (scene, _) = load_scene("pipeline", &[]).unwrap();
+        let model = Model::new(&scene).unwrap();
+        let full = 1.0 / 250.0;
+        assert_eq!(model.predictor_scale(50.0 * full, 51.0 * full), 0.0);
+        assert!(close(model.predictor_scale(51.0 * full, 52.0 * full), 1.0));
+        // Without bodies, proportional loading.
+        let (scene, _) = load_scene("cantilever", &[]).unwrap();
+        let model = Model::new(&scene).unwrap();
+        assert!(close(
+            model.predictor_scale(0.3, 0.35),
+            0.05 * scene.steps.count as f64
+        ));
+    }
 
     #[test]
     fn rigid_platen_takes_particles_that_reach_it_onto_its_face() {

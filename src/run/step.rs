@@ -259,7 +259,7 @@ impl Simulation {
                 .step_bc(self.reference_position(mesh, p), mesh.points[p], from, to)
         });
         // The last increment scaled to this one is the predictor.
-        let scale = (to - from) * self.model.scene.steps.count as f64;
+        let scale = self.model.predictor_scale(from, to);
         let factor = to;
         let mut point_loads = Vec::new();
         for (load, &gid) in self
