@@ -313,6 +313,59 @@ impl Simulation {
 pub const PENETRATION_LIMIT: f64 = 0.5;
 
 impl Simulation {
+    /// Collective. Whether a converged increment `du` (per local node of `dofs`) keeps every
+    /// particle out of the rigid bodies, where they are at load factor `to`, to
+    /// [`PENETRATION_LIMIT`] of its spacing. Contact holds only the nodes found near a body at
+    /// the increment's start, and Newton can carry another one through it: on the `spudcan`
+    /// an axis particle 0.2 m under the tip, its boundary edge a free surface, went 0.64 m up
+    /// into the body in a step that moved the spudcan 0.025 m down, and the run ended. Such an
+    /// increment is a divergence: a smaller one is tried.
+    pub(super) fn check_through_bodies(
+        &self,
+        world: &pfem_partition::Comm,
+        mesh: &crate::mesh::LocalMesh,
+        dofs: &crate::solve::DofMap,
+        du: &[[f64; 2]],
+        to: f64,
+        step: u64,
+    ) -> Result<(), super::step::SolveError> {
+        if self.model.bodies.is_empty() {
+            return Ok(());
+        }
+        let shapes: Vec<_> = self.model.bodies.iter().map(|b| b.shape(to)).collect();
+        let mut worst: Option<(f64, u64, usize)> = None;
+        for p in 0..mesh.n_owned {
+            let node = dofs.node_of_point[p];
+            if node == u32::MAX {
+                continue;
+            }
+            let d = du[node as usize];
+            let x = [mesh.points[p][0] + d[0], mesh.points[p][1] + d[1]];
+            for (b, shape) in shapes.iter().enumerate() {
+                let depth = -shape.closest(x).distance / self.particles.h[p];
+                if worst.is_none_or(|w| depth > w.0) {
+                    worst = Some((depth, mesh.gids[p], b));
+                }
+            }
+        }
+        let local = worst
+            .filter(|w| w.0 > PENETRATION_LIMIT)
+            .map(|(depth, gid, b)| {
+                format!(
+                    "step {step}: Newton converged with particle {gid} inside rigid body '{}' by \
+                 {depth:.2} of its spacing (limit {PENETRATION_LIMIT})",
+                    self.model.bodies[b].name
+                )
+            });
+        // Every rank returns the lowest failing rank's divergence.
+        match pfem_partition::agree_on_error(world, local) {
+            None => Ok(()),
+            Some(message) => Err(super::step::SolveError::ContactUnsettled(message)),
+        }
+    }
+}
+
+impl Simulation {
     /// Collective. The deepest penetration of a particle into a rigid body, as a fraction of
     /// its spacing (0 when none), and an error when it passes [`PENETRATION_LIMIT`]: the soil
     /// has passed through the body.

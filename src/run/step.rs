@@ -296,9 +296,18 @@ impl Simulation {
         let mut cache = self
             .solver_objects(world, mesh, &dofs, &constraints)
             .map_err(|e| err(e.to_string()))?;
-        let outcome = self.solve_with(
-            world, mesh, &dofs, setup, &spacing, &mut cache, scale, from, step,
-        );
+        let outcome = self
+            .solve_with(
+                world, mesh, &dofs, setup, &spacing, &mut cache, scale, from, step,
+            )
+            .and_then(|o| {
+                self.check_through_bodies(world, mesh, &dofs, &o.du, to, step)
+                    .inspect_err(|_| {
+                        let s = &o.stats;
+                        self.count_failed_try([s.newton_iterations, s.linear_iterations])
+                    })?;
+                Ok(o)
+            });
         // Kept for the next increment on the same pattern (a cut piece, or an unchanged mesh),
         // where a factorisation's symbolic phase is reused. An iterative solver sets up afresh
         // anyway, and its matrices would sit under the peak of the mapping, output and
