@@ -333,21 +333,15 @@ impl Simulation {
             return Ok(());
         }
         let shapes: Vec<_> = self.model.bodies.iter().map(|b| b.shape(to)).collect();
-        let mut worst: Option<(f64, u64, usize)> = None;
-        for p in 0..mesh.n_owned {
+        let moved = (0..mesh.n_owned).filter_map(|p| {
             let node = dofs.node_of_point[p];
-            if node == u32::MAX {
-                continue;
-            }
-            let d = du[node as usize];
-            let x = [mesh.points[p][0] + d[0], mesh.points[p][1] + d[1]];
-            for (b, shape) in shapes.iter().enumerate() {
-                let depth = -shape.closest(x).distance / self.particles.h[p];
-                if worst.is_none_or(|w| depth > w.0) {
-                    worst = Some((depth, mesh.gids[p], b));
-                }
-            }
-        }
+            (node != u32::MAX).then(|| {
+                let d = du[node as usize];
+                let x = [mesh.points[p][0] + d[0], mesh.points[p][1] + d[1]];
+                (x, self.particles.h[p], mesh.gids[p])
+            })
+        });
+        let worst = deepest(&shapes, moved);
         let local = worst
             .filter(|w| w.0 > PENETRATION_LIMIT)
             .map(|(depth, gid, b)| {
@@ -377,17 +371,10 @@ impl Simulation {
             return Ok(0.0);
         }
         let lambda = self.header.load_factor;
-        let mut worst: Option<(f64, u64, usize)> = None;
-        for (bi, body) in self.model.bodies.iter().enumerate() {
-            let shape = body.shape(lambda);
-            for i in 0..self.particles.len() {
-                let depth =
-                    -shape.closest(self.particles.position[i]).distance / self.particles.h[i];
-                if worst.is_none_or(|w| depth > w.0) {
-                    worst = Some((depth, self.particles.gid[i], bi));
-                }
-            }
-        }
+        let shapes: Vec<_> = self.model.bodies.iter().map(|b| b.shape(lambda)).collect();
+        let p = &self.particles;
+        let here = (0..p.len()).map(|i| (p.position[i], p.h[i], p.gid[i]));
+        let worst = deepest(&shapes, here);
         let local = worst.map_or(0.0, |w| w.0.max(0.0));
         let deepest = pfem_partition::max_f64(world, local);
         let error = worst
@@ -402,6 +389,24 @@ impl Simulation {
         super::error::agree(world, error)?;
         Ok(deepest)
     }
+}
+
+/// The deepest of `points` (position, spacing, gid) inside any of `shapes`: its depth as a
+/// fraction of its spacing (negative when all are outside), gid and body index.
+fn deepest(
+    shapes: &[Shape],
+    points: impl Iterator<Item = ([f64; 2], f64, u64)>,
+) -> Option<(f64, u64, usize)> {
+    let mut worst: Option<(f64, u64, usize)> = None;
+    for (x, h, gid) in points {
+        for (b, shape) in shapes.iter().enumerate() {
+            let depth = -shape.closest(x).distance / h;
+            if worst.is_none_or(|w| depth > w.0) {
+                worst = Some((depth, gid, b));
+            }
+        }
+    }
+    worst
 }
 
 /// Whether the boundary edge with nodes `nodes` from `xa` to `xb` runs along a support that holds
@@ -445,7 +450,29 @@ fn node_info(
 
 #[cfg(test)]
 mod tests {
-    use super::along_support;
+    use super::{along_support, deepest, PENETRATION_LIMIT};
+    use crate::rigid::Shape;
+
+    #[test]
+    fn deepest_particle_is_measured_in_its_own_spacing() {
+        let shapes = [
+            Shape::circle([0.0, 0.0], 1.0).unwrap(),
+            Shape::circle([5.0, 0.0], 1.0).unwrap(),
+        ];
+        assert!(deepest(&shapes, std::iter::empty()).is_none());
+        let outside = deepest(&shapes, [([0.0, 3.0], 1.0, 7)].into_iter()).unwrap();
+        assert!((outside.0 + 2.0).abs() < 1e-12 && outside.1 == 7);
+        // 0.3 deep at spacing 0.5 is deeper (0.6) than 0.4 deep at spacing 1.
+        let points = [
+            ([0.0, 0.6], 1.0, 1),
+            ([5.0, 0.7], 0.5, 2),
+            ([2.5, 0.0], 0.1, 3),
+        ];
+        let (depth, gid, body) = deepest(&shapes, points.into_iter()).unwrap();
+        assert!((depth - 0.6).abs() < 1e-12, "{depth}");
+        assert_eq!((gid, body), (2, 1));
+        assert!(depth > PENETRATION_LIMIT);
+    }
 
     #[test]
     fn only_edges_along_a_support_that_holds_them_across_are_cuts() {
