@@ -466,34 +466,21 @@ mod tests {
         // 120 steps down, then 240 up, 240 down, ...: 4 920 steps.
         let (scene, _) = load_scene("tbar-softening", &[]).unwrap();
         let model = Model::new(&scene).unwrap();
-        let full = 1.0 / 4920.0;
-        let at = |step: f64| step * full;
-        assert!(
-            close(model.predictor_scale(at(0.0), at(1.0)), 1.0),
-            "first step"
-        );
-        assert!(
-            close(model.predictor_scale(at(5.0), at(6.0)), 1.0),
-            "within a stage"
-        );
-        assert!(
-            close(model.predictor_scale(at(5.0), at(5.25)), 0.25),
-            "a piece"
-        );
+        let at = |step: f64| step / 4920.0;
         // The second stage goes up at half the first's speed per step: 0.06 m in 240 steps
         // against 0.06 m in 120; the third down at 0.12 m in 240.
-        assert!(
-            close(model.predictor_scale(at(120.0), at(121.0)), -0.5),
-            "reversal"
-        );
-        assert!(
-            close(model.predictor_scale(at(120.5), at(121.0)), 0.5),
-            "piece after it"
-        );
-        assert!(
-            close(model.predictor_scale(at(360.0), at(360.5)), -1.0),
-            "next reversal"
-        );
+        let cases = [
+            ("first step", 0.0, 1.0, 1.0),
+            ("within a stage", 5.0, 6.0, 1.0),
+            ("a piece", 5.0, 5.25, 0.25),
+            ("reversal", 120.0, 121.0, -0.5),
+            ("piece after it", 120.5, 121.0, 0.5),
+            ("next reversal", 360.0, 360.5, -1.0),
+        ];
+        for (what, from, to, want) in cases {
+            let got = model.predictor_scale(at(from), at(to));
+            assert!(close(got, want), "{what}: {got} against {want}");
+        }
         // The pipeline turns from vertical (0.02 m in 50 steps) to lateral.
         let (scene, _) = load_scene("pipeline", &[]).unwrap();
         let model = Model::new(&scene).unwrap();
