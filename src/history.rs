@@ -98,13 +98,17 @@ fn declared(scene: &Scene, m: &Measures, measure: &str) -> Result<f64, String> {
                 .ok_or_else(missing)?;
             m.rigid_displacement.get(i).ok_or_else(missing)?[c]
         }
-        Measure::RigidForce(name, c) => {
-            let i = scene
-                .rigid
-                .iter()
-                .position(|r| r.name == name)
-                .ok_or_else(missing)?;
-            m.rigid_force.get(i).ok_or_else(missing)?[c]
+        Measure::RigidForce(names, c) => {
+            let mut sum = 0.0;
+            for name in names {
+                let i = scene
+                    .rigid
+                    .iter()
+                    .position(|r| r.name == name)
+                    .ok_or_else(missing)?;
+                sum += m.rigid_force.get(i).ok_or_else(missing)?[c];
+            }
+            sum
         }
         Measure::Reaction(name, c) => {
             let names: Vec<Option<&String>> = scene

@@ -193,8 +193,9 @@ pub struct Probe {
 /// Measures: `load_factor`, `time` (s, when the scene gives its steps a time: `steps.duration`
 /// or timed `[[rigid]]` stages; else the load factor), `area` (body area, m²), `probe.NAME.ux|uy`,
 /// `rigid.NAME.ux|uy` (the body's displacement), `rigid.NAME.fx|fy` (the force the soil puts on
-/// the body: the sum of the contact tractions, N/m), `reaction.NAME.fx|fy` (the force on the
-/// particles of a named `[[fixed]]` or `[[prescribed]]` set).
+/// the body: the sum of the contact tractions, N/m), `rigid.NAME+NAME.fx|fy` (the sum over
+/// bodies moved together, such as a cone and its shaft), `reaction.NAME.fx|fy` (the force on
+/// the particles of a named `[[fixed]]` or `[[prescribed]]` set).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Column {
@@ -224,7 +225,8 @@ pub enum Measure {
     Area,
     Probe(String, usize),
     RigidDisplacement(String, usize),
-    RigidForce(String, usize),
+    /// The force on one body, or the sum over bodies moved together (`rigid.cone+shaft.fy`).
+    RigidForce(Vec<String>, usize),
     Reaction(String, usize),
 }
 
@@ -239,7 +241,8 @@ impl Measure {
         let bad = || {
             format!(
                 "unknown measure \"{text}\" (expected load_factor, time, area, probe.NAME.ux|uy, \
-                 rigid.NAME.ux|uy|fx|fy or reaction.NAME.fx|fy)"
+                 rigid.NAME.ux|uy|fx|fy, rigid.NAME+NAME.fx|fy or \
+                 reaction.NAME.fx|fy)"
             )
         };
         match parts.as_slice() {
@@ -249,11 +252,19 @@ impl Measure {
             ["probe", n, c] => comp(c, "ux", "uy")
                 .map(|i| Measure::Probe(n.to_string(), i))
                 .ok_or_else(bad),
-            ["rigid", n, c] => match (comp(c, "ux", "uy"), comp(c, "fx", "fy")) {
-                (Some(i), _) => Ok(Measure::RigidDisplacement(n.to_string(), i)),
-                (_, Some(i)) => Ok(Measure::RigidForce(n.to_string(), i)),
-                _ => Err(bad()),
-            },
+            ["rigid", n, c] => {
+                let names: Vec<String> = n.split('+').map(str::to_string).collect();
+                if names.iter().any(String::is_empty) {
+                    return Err(bad());
+                }
+                match (comp(c, "ux", "uy"), comp(c, "fx", "fy")) {
+                    (Some(i), _) if names.len() == 1 => {
+                        Ok(Measure::RigidDisplacement(n.to_string(), i))
+                    }
+                    (_, Some(i)) => Ok(Measure::RigidForce(names, i)),
+                    _ => Err(bad()),
+                }
+            }
             ["reaction", n, c] => comp(c, "fx", "fy")
                 .map(|i| Measure::Reaction(n.to_string(), i))
                 .ok_or_else(bad),
@@ -327,8 +338,14 @@ mod tests {
     fn measures_parse() {
         assert_eq!(
             Measure::parse("rigid.tbar.fy"),
-            Ok(Measure::RigidForce("tbar".into(), 1))
+            Ok(Measure::RigidForce(vec!["tbar".into()], 1))
         );
+        assert_eq!(
+            Measure::parse("rigid.cone+shaft.fy"),
+            Ok(Measure::RigidForce(vec!["cone".into(), "shaft".into()], 1))
+        );
+        assert!(Measure::parse("rigid.cone+shaft.uy").is_err());
+        assert!(Measure::parse("rigid.cone+.fy").is_err());
         assert_eq!(
             Measure::parse("probe.tip.ux"),
             Ok(Measure::Probe("tip".into(), 0))

@@ -504,3 +504,16 @@ fn the_committed_scene_reference_is_up_to_date() {
         assert!(committed.contains(key), "{key} is missing");
     }
 }
+
+#[test]
+fn a_summed_force_names_bodies_that_exist() {
+    let sets = |m: &str| vec![format!("history.columns=[{{name=\"F\",measure=\"{m}\"}}]")];
+    assert!(load_scene("tbar-smooth", &sets("rigid.tbar+tbar.fy")).is_ok());
+    let e = load_scene("tbar-smooth", &sets("rigid.tbar+shaft.fy")).unwrap_err();
+    assert_eq!(
+        e.field.as_deref(),
+        Some("history.columns[0].measure"),
+        "{e}"
+    );
+    assert!(e.to_string().contains("names no"), "{e}");
+}

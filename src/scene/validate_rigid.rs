@@ -297,8 +297,9 @@ fn check_history(s: &Scene) -> Result<(), Invalid> {
         let m = Measure::parse(&c.measure).map_err(|e| (path.join("measure"), e))?;
         let known = match &m {
             Measure::Probe(n, _) => s.probe.iter().any(|p| &p.name == n),
-            Measure::RigidDisplacement(n, _) | Measure::RigidForce(n, _) => {
-                s.rigid.iter().any(|r| &r.name == n)
+            Measure::RigidDisplacement(n, _) => s.rigid.iter().any(|r| &r.name == n),
+            Measure::RigidForce(names, _) => {
+                names.iter().all(|n| s.rigid.iter().any(|r| &r.name == n))
             }
             Measure::Reaction(n, _) => set_names.contains(&n),
             _ => true,
