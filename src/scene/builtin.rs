@@ -35,6 +35,7 @@ pub const BUILTINS: &[(&str, &str)] = &[
     ),
     ("ball", include_str!("builtin/ball.toml")),
     ("spudcan", include_str!("builtin/spudcan.toml")),
+    ("cpt", include_str!("builtin/cpt.toml")),
     (
         "footing-mohr-coulomb",
         include_str!("builtin/footing-mohr-coulomb.toml"),
