@@ -19,13 +19,13 @@ fn cpt_loads_its_shoulder_without_dropping_and_agrees_on_1_and_2_ranks() {
         runs.push(rows);
     }
     let rows = &runs[0];
-    // Once the shoulder is in the clay (the cone is 0.87 D long) no step loses more than a
-    // quarter of the load: measured at most 20 % (at z/D = 0.86, as the shoulder enters).
-    // With the shoulder a corner of one polygon rounded by 0.5 mm, its chord's midside node
-    // dropped out of contact and the load fell to 37 % of the step before.
+    // Once the shoulder is in the clay (the cone is 0.87 D long) no step loses more than 15 %
+    // of the load: measured at most 7 % over z/D = 0.92–1.5 (at 1.14). With the shoulder a
+    // corner of one polygon rounded by 0.5 mm, its chord's midside node dropped out of contact:
+    // 21 % over the same steps, and the load fell to 37 % of the step before deeper down.
     for w in rows[45..].windows(2) {
         assert!(
-            w[1][2] > 0.75 * w[0][2],
+            w[1][2] > 0.85 * w[0][2],
             "Nkt {} at z/D = {} after {}",
             w[1][2],
             w[1][1],
