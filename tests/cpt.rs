@@ -44,13 +44,5 @@ fn cpt_loads_its_shoulder_without_dropping_and_agrees_on_1_and_2_ranks() {
     let last = rows[74][2];
     assert!((5.5..=8.0).contains(&last), "Nkt = {last} at z/D = 1.5");
     // 1 and 2 ranks on the same path.
-    for (a, b) in runs[0].iter().zip(&runs[1]) {
-        assert!(
-            (a[2] - b[2]).abs() <= 1e-6 * a[2].abs(),
-            "z/D = {}: Nkt = {} on 1 rank, {} on 2",
-            a[1],
-            a[2],
-            b[2]
-        );
-    }
+    same_path(&runs[0], &runs[1], 2, 1e-6);
 }

@@ -57,13 +57,5 @@ fn coarse_spudcan_bears_near_the_surface_factor_and_agrees_on_1_and_2_ranks() {
     // 1 and 2 ranks take the same path through the step-cuts: measured within 1e-14 (15.9 %
     // apart at z/D = 0.03 while ranks kept stale copies of the interface triangles around a
     // particle another rank smoothed).
-    for (a, b) in runs[0].iter().zip(&runs[1]) {
-        assert!(
-            (a[2] - b[2]).abs() <= 1e-9 * a[2].abs(),
-            "z/D = {}: N = {} on 1 rank, {} on 2",
-            a[1],
-            a[2],
-            b[2]
-        );
-    }
+    same_path(&runs[0], &runs[1], 2, 1e-9);
 }

@@ -106,6 +106,21 @@ pub fn history(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     (header, rows)
 }
 
+/// Two runs' histories on the same path: column `col` of every row within `rel` (relative), the
+/// row named by its column 1 (the depth or displacement) when not.
+pub fn same_path(a: &[Vec<f64>], b: &[Vec<f64>], col: usize, rel: f64) {
+    assert_eq!(a.len(), b.len(), "rows");
+    for (x, y) in a.iter().zip(b) {
+        assert!(
+            (x[col] - y[col]).abs() <= rel * x[col].abs(),
+            "at {}: {} against {}",
+            x[1],
+            x[col],
+            y[col]
+        );
+    }
+}
+
 /// `pfem-mpi new cantilever -o c.h5` with spacing `h` (m), `steps` load steps and any further
 /// `--set key=value` overrides.
 pub fn cantilever_case(dir: &Path, h: &str, steps: u32, sets: &[&str]) {
