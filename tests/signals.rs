@@ -75,7 +75,16 @@ fn sigusr1_from_start_up_to_the_end_checkpoints_and_exits_zero() {
     small_cantilever(&dir, 16, &[]);
     // Seconds after both ranks can catch the signal: at once (MPI is still starting), then
     // while the case loads, during the first steps, and at or after the end of the run.
-    for (k, delay) in [0.0_f64, 0.1, 0.3, 0.8, 2.0, 8.0].into_iter().enumerate() {
+    // One thread when a rank is first seen catching SIGUSR1: its handlers were there before MPI
+    // started its own threads. The poll can come late on a busy machine (CI saw [1, 3] once),
+    // so the signal at once is sent up to five times, and one start seen in time proves the order;
+    // handlers installed after MPI would never show one thread.
+    let mut seen_before_mpi = false;
+    let delays = [0.0_f64, 0.0, 0.0, 0.0, 0.0, 0.1, 0.3, 0.8, 2.0, 8.0];
+    for (k, delay) in delays.into_iter().enumerate() {
+        if k > 0 && k < 5 && seen_before_mpi {
+            continue;
+        }
         let out = format!("o{k}");
         let mut child = mpirun(2)
             .args(["c.h5", "--out", &out])
@@ -85,11 +94,8 @@ fn sigusr1_from_start_up_to_the_end_checkpoints_and_exits_zero() {
             .spawn()
             .expect("spawn mpirun");
         let threads = wait_for_handlers(&mut child);
-        // One thread: the handlers were there before MPI started its own threads.
-        if delay == 0.0 && threads.iter().any(|&t| t != 1) {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("the handlers came after MPI started (threads {threads:?})");
+        if threads.contains(&1) {
+            seen_before_mpi = true;
         }
         std::thread::sleep(Duration::from_secs_f64(delay));
         let _ = std::process::Command::new("kill")
@@ -107,4 +113,8 @@ fn sigusr1_from_start_up_to_the_end_checkpoints_and_exits_zero() {
         let info = ok(&dir, 1, &["info", &format!("{out}/checkpoints/{newest}")]);
         assert!(info.contains("particles"), "{info}");
     }
+    assert!(
+        seen_before_mpi,
+        "in five starts no rank caught SIGUSR1 while it ran one thread: the handlers come after MPI"
+    );
 }
