@@ -28,6 +28,11 @@ pub struct ContactPair {
     pub node: u32,
     /// Index of the rigid body.
     pub body: u32,
+    /// A second body moved with `body` (a cone and the shaft above it; `body` itself when
+    /// none): the node is held against their union, whichever of the two it is nearer at each
+    /// iterate. Where a node slides from one onto the other within an increment, a law against
+    /// the first alone would pull it into the second, around the first one's hidden corner.
+    pub partner: u32,
     /// Node position at the start of the increment.
     pub start: [f64; 2],
     /// Boundary length the node stands for (m per metre).
@@ -74,6 +79,8 @@ pub enum Status {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NodeLaw {
     pub status: Status,
+    /// The body the node is held against at this iterate (the pair's body or its partner).
+    pub body: u32,
     /// The node's residual rows (component x, y; only free components are rows).
     pub rows: [f64; 2],
     /// The rows' dependence on the element rows: row i = Σ_j transform[i][j] R_j + (rest).
@@ -94,7 +101,30 @@ pub struct NodeLaw {
 /// meets it square, |n_free| = 1).
 const MIN_FREE_NORMAL: f64 = 0.1;
 
-/// The law of `pair` at its increment displacement `u`, against `shape` (the body at the end
+/// The law of `pair` against the nearer of its body and its partner (`shapes`: every body at
+/// the end of the increment, by index), the lower index on a tie. The union of two bodies is
+/// the body with the smaller signed distance; where the two faces meet tangentially (the
+/// built-in cone's face and its shaft's arc) the law changes body without a jump.
+pub fn node_law_among(pair: &ContactPair, shapes: &[Shape], u: [f64; 2], r: [f64; 2]) -> NodeLaw {
+    let (a, b) = (pair.body.min(pair.partner), pair.body.max(pair.partner));
+    if a == b {
+        return node_law(pair, &shapes[a as usize], u, r);
+    }
+    let x = [pair.start[0] + u[0], pair.start[1] + u[1]];
+    let nearer = if shapes[b as usize].closest(x).distance < shapes[a as usize].closest(x).distance
+    {
+        b
+    } else {
+        a
+    };
+    let facing = ContactPair {
+        body: nearer,
+        ..*pair
+    };
+    node_law(&facing, &shapes[nearer as usize], u, r)
+}
+
+/// The law of `pair` at its increment displacement `u`, against `shape` (its body at the end
 /// of the increment), where the soil's residual at the node is `r`.
 pub fn node_law(pair: &ContactPair, shape: &Shape, u: [f64; 2], r: [f64; 2]) -> NodeLaw {
     let x = [pair.start[0] + u[0], pair.start[1] + u[1]];
@@ -113,6 +143,7 @@ pub fn node_law(pair: &ContactPair, shape: &Shape, u: [f64; 2], r: [f64; 2]) -> 
     let pull = -floor;
     let free = NodeLaw {
         status: Status::Free,
+        body: pair.body,
         rows: [r[0] + pull * w * n[0], r[1] + pull * w * n[1]],
         transform: [[1.0, 0.0], [0.0, 1.0]],
         local: std::array::from_fn(|i| std::array::from_fn(|j| pull * w * kappa * t[i] * t[j])),
@@ -168,6 +199,7 @@ pub fn node_law(pair: &ContactPair, shape: &Shape, u: [f64; 2], r: [f64; 2]) -> 
     };
     let mut law = NodeLaw {
         status: Status::Stick,
+        body: pair.body,
         rows: [0.0; 2],
         transform: [[0.0; 2]; 2],
         local: [[0.0; 2]; 2],
@@ -217,6 +249,7 @@ mod tests {
         ContactPair {
             node: 0,
             body: 0,
+            partner: 0,
             start: [0.3, -0.96],
             weight: 0.05,
             constant: 1e6,
@@ -341,5 +374,52 @@ mod tests {
         );
         assert_eq!(slide.shear, -500.0);
         assert!((slide.rows[0] - (-0.05 * 500.0)).abs() < 1e-12);
+    }
+
+    /// The built-in cone and its shaft in units of the shaft's radius: the shaft's corner arc
+    /// is tangent to the cone's face just below the cone's (hidden) top corner.
+    fn cone_and_shaft() -> (Vec<Shape>, [f64; 2], f64) {
+        let (top, base, r2) = ([0.928_18, 1.607_66], 1.189_40, 0.745_1);
+        let cone = Shape::polygon(&[[0.0, 0.0], top, [-top[0], top[1]]], 0.028).unwrap();
+        let shaft =
+            Shape::polygon(&[[1.0, base], [1.0, 10.0], [-1.0, 10.0], [-1.0, base]], r2).unwrap();
+        (vec![cone, shaft], [1.0 - r2, base + r2], r2)
+    }
+
+    #[test]
+    fn a_node_held_against_two_bodies_follows_their_union() {
+        let (shapes, centre, r2) = cone_and_shaft();
+        let on_arc = |deg: f64| {
+            let a = deg.to_radians();
+            [centre[0] + r2 * a.cos(), centre[1] + r2 * a.sin()]
+        };
+        // On the shaft's arc 15° past where it leaves the cone's face (the face's normal points
+        // 30° below the horizontal), the soil's residual along the normal: it presses on.
+        let x = on_arc(-15.0);
+        let n = [(-15f64).to_radians().cos(), (-15f64).to_radians().sin()];
+        let push = [400.0 * n[0], 400.0 * n[1]];
+        let mut p = pair(0.0);
+        p.start = x;
+        p.body_increment = [0.0; 2];
+        p.partner = 1;
+        let law = node_law_among(&p, &shapes, [0.0; 2], push);
+        assert_eq!((law.status, law.body), (Status::Stick, 1));
+        assert!(law.gap.abs() < 1e-9, "on the union's face: gap {}", law.gap);
+        // Against the cone alone the node is off its face: held there, it would be pulled into
+        // the shaft around the cone's top corner.
+        let cone_only = node_law(&p, &shapes[0], [0.0; 2], push);
+        assert!(cone_only.gap > 0.05, "gap to the cone {}", cone_only.gap);
+        // The pair's order does not matter, and below the tangent point the cone holds it.
+        let swapped = ContactPair {
+            body: 1,
+            partner: 0,
+            ..p
+        };
+        assert_eq!(node_law_among(&swapped, &shapes, [0.0; 2], push), law);
+        let face = [0.5 * 0.928_18, 0.5 * 1.607_66];
+        let below = ContactPair { start: face, ..p };
+        let law = node_law_among(&below, &shapes, [0.0; 2], [346.4, -200.0]);
+        assert_eq!((law.status, law.body), (Status::Stick, 0));
+        assert!(law.gap.abs() < 1e-9, "on the cone's face: gap {}", law.gap);
     }
 }

@@ -8,7 +8,7 @@ pub mod edge_tree;
 pub mod shape;
 
 pub use body::RigidBody;
-pub use contact::{node_law, ContactPair, NodeLaw, Status};
+pub use contact::{node_law, node_law_among, ContactPair, NodeLaw, Status};
 pub use shape::{Proximity, Shape};
 
 /// The proximity of `x` to the body it lies deepest in, or nearest to (smallest signed

@@ -124,6 +124,8 @@ impl Simulation {
         };
         // Each pair's distance to its body at the start (to keep the nearest body's pair).
         let mut start_distance = Vec::new();
+        // Each pair's boundary edges facing its body (edge index, the node's weight on it).
+        let mut facing_edges: Vec<Vec<(usize, f64)>> = Vec::new();
         for (bi, body) in model.bodies.iter().enumerate() {
             let shape = &out.bodies[bi];
             let shape_from = body.shape(from);
@@ -135,7 +137,7 @@ impl Simulation {
             // A node's weight counts only the boundary edges facing this body (midpoint within
             // a quarter spacing of it, plus its motion): a corner node of a platen does not
             // stand for the free side below it, whose length would add to its share of α·cu.
-            let mut weight: HashMap<u32, f64> = HashMap::new();
+            let mut weight: HashMap<u32, Vec<(usize, f64)>> = HashMap::new();
             let near = |x: &[f64; 2], h: f64| {
                 let margin = 0.25 * h + moved;
                 let outside_box = x[0] < bb[0][0] - margin
@@ -144,31 +146,32 @@ impl Simulation {
                     || x[1] > bb[1][1] + margin;
                 !outside_box && shape.closest(*x).distance <= margin
             };
-            for (nodes, xs, weights, h, on_support) in &edges {
+            for (ei, (nodes, xs, weights, h, on_support)) in edges.iter().enumerate() {
                 if *on_support || !near(&xs[1], *h) {
                     continue;
                 }
                 for (node, wk) in nodes.iter().zip(weights) {
-                    *weight.entry(*node).or_default() += wk;
+                    weight.entry(*node).or_default().push((ei, *wk));
                 }
             }
             // A node near the body on no such edge (under a cone's tip, where the midpoints of
             // the edges beside it are still far off) stands for its own share of its edges.
-            let mut tips: HashMap<u32, f64> = HashMap::new();
-            for (nodes, xs, weights, h, _) in edges.iter().filter(|e| !e.4) {
+            let mut tips: HashMap<u32, Vec<(usize, f64)>> = HashMap::new();
+            for (ei, (nodes, xs, weights, h, _)) in edges.iter().enumerate().filter(|e| !e.1 .4) {
                 for k in [0, 2] {
                     if !weight.contains_key(&nodes[k]) && near(&xs[k], *h) {
-                        *tips.entry(nodes[k]).or_default() += weights[k];
+                        tips.entry(nodes[k]).or_default().push((ei, weights[k]));
                     }
                 }
             }
             weight.extend(tips);
-            let mut nodes: Vec<(u32, f64)> = weight
+            let mut nodes: Vec<(u32, Vec<(usize, f64)>)> = weight
                 .into_iter()
                 .filter(|(n, _)| dofs.node_owned[*n as usize])
                 .collect();
             nodes.sort_unstable_by_key(|(n, _)| *n);
-            for &(n, w) in &nodes {
+            for (n, facing) in nodes {
+                let w = facing.iter().map(|f| f.1).sum();
                 let (x, h, key) = node_info(mesh, dofs, n as usize, n_vertex);
                 // A midside node of an edge cut across a (rounded) corner starts well inside the
                 // body, where the normal turns fast or jumps between faces: Newton stalls on
@@ -189,6 +192,7 @@ impl Simulation {
                 out.pairs.push(ContactPair {
                     node: n,
                     body: bi as u32,
+                    partner: bi as u32,
                     start: x,
                     weight: w,
                     constant: model.scene.contact.penalty * young / h,
@@ -202,17 +206,20 @@ impl Simulation {
                 });
                 out.spacing.push(h);
                 start_distance.push(start);
+                facing_edges.push(facing);
             }
         }
-        keep_nearest_body(&mut out, &start_distance);
+        join_bodies(&mut out, &start_distance, &facing_edges);
         out
     }
 }
 
-/// A node near two bodies (a cone and the shaft above it, two bodies moving as one) holds its
-/// rows for one law only: it keeps the pair of the body it starts nearest to (the lower body
-/// index on a tie), so that the choice does not depend on the partition.
-fn keep_nearest_body(out: &mut BoundaryLoads, start_distance: &[f64]) {
+/// A node near two bodies holds its rows for one law only: it keeps the pair of the body it
+/// starts nearest to (the lower body index on a tie), so that the choice does not depend on
+/// the partition. When the other body moves with it (the same increment and interface: a cone
+/// and the shaft above it), that body becomes the pair's partner, the node is held against
+/// their union, and it stands for the boundary edges facing either.
+fn join_bodies(out: &mut BoundaryLoads, start_distance: &[f64], facing: &[Vec<(usize, f64)>]) {
     let mut best: HashMap<u32, usize> = HashMap::new();
     for (i, pair) in out.pairs.iter().enumerate() {
         best.entry(pair.node)
@@ -225,6 +232,41 @@ fn keep_nearest_body(out: &mut BoundaryLoads, start_distance: &[f64]) {
     }
     if best.len() == out.pairs.len() {
         return;
+    }
+    let together = |a: &ContactPair, b: &ContactPair| {
+        a.body_increment == b.body_increment
+            && a.shear_limit == b.shear_limit
+            && a.suction == b.suction
+    };
+    // The nearest other pair of the same node whose body moves with the kept one.
+    let mut partner: HashMap<u32, usize> = HashMap::new();
+    for (i, pair) in out.pairs.iter().enumerate() {
+        let b = best[&pair.node];
+        if i == b || !together(&out.pairs[b], pair) {
+            continue;
+        }
+        partner
+            .entry(pair.node)
+            .and_modify(|p| {
+                if start_distance[i] < start_distance[*p] {
+                    *p = i;
+                }
+            })
+            .or_insert(i);
+    }
+    for (&node, &p) in &partner {
+        let b = best[&node];
+        let mut edges = facing[b].clone();
+        edges.extend(
+            facing[p]
+                .iter()
+                .filter(|e| !facing[b].iter().any(|f| f.0 == e.0)),
+        );
+        let (other_body, other_touching) = (out.pairs[p].body, out.pairs[p].touching);
+        let kept = &mut out.pairs[b];
+        kept.partner = other_body;
+        kept.weight = edges.iter().map(|e| e.1).sum();
+        kept.touching |= other_touching;
     }
     let keep: Vec<bool> = (0..out.pairs.len())
         .map(|i| best[&out.pairs[i].node] == i)
@@ -450,8 +492,8 @@ fn node_info(
 
 #[cfg(test)]
 mod tests {
-    use super::{along_support, deepest, PENETRATION_LIMIT};
-    use crate::rigid::Shape;
+    use super::{along_support, deepest, join_bodies, BoundaryLoads, PENETRATION_LIMIT};
+    use crate::rigid::{ContactPair, Shape};
 
     #[test]
     fn deepest_particle_is_measured_in_its_own_spacing() {
@@ -487,5 +529,65 @@ mod tests {
         let held_y = |_: u32, c: usize| c == 1;
         assert!(along_support(held_y, [4, 5, 6], [0.2, 0.0], [0.7, 0.0]));
         assert!(!along_support(held_y, [4, 5, 6], [0.2, 0.0], [0.7, 0.3]));
+    }
+
+    #[test]
+    fn a_node_near_two_bodies_moved_together_holds_against_both() {
+        let pair = |node: u32, body: u32, inc: [f64; 2], touching: bool| ContactPair {
+            node,
+            body,
+            partner: body,
+            start: [0.0; 2],
+            weight: 0.0,
+            constant: 1.0,
+            row_scale: 1.0,
+            shear_limit: 0.0,
+            body_increment: inc,
+            offset: 0.0,
+            touching,
+            suction: 0.0,
+            free: [true, true],
+        };
+        let down = [0.0, -0.01];
+        // Node 5 near bodies 0 and 1 (moved together), node 6 near bodies 0 and 2 (body 2 held),
+        // node 7 near body 1 only. Edges 10-12 face the bodies: node 5's edge 11 faces both.
+        let mut out = BoundaryLoads {
+            pairs: vec![
+                pair(5, 0, down, false),
+                pair(6, 0, down, false),
+                pair(5, 1, down, true),
+                pair(7, 1, down, false),
+                pair(6, 2, [0.0; 2], false),
+            ],
+            spacing: vec![1.0, 2.0, 3.0, 4.0, 5.0],
+            bodies: Vec::new(),
+            surface: Vec::new(),
+            surface_edges: Vec::new(),
+        };
+        let start = [0.02, 0.01, 0.0, 0.5, -0.001];
+        let facing = [
+            vec![(10, 0.1), (11, 0.2)],
+            vec![(10, 0.3)],
+            vec![(11, 0.2), (12, 0.4)],
+            vec![(12, 1.0)],
+            vec![(13, 0.7)],
+        ];
+        join_bodies(&mut out, &start, &facing);
+        let kept: Vec<(u32, u32, u32)> = out
+            .pairs
+            .iter()
+            .map(|p| (p.node, p.body, p.partner))
+            .collect();
+        // Node 5 keeps body 1 (it starts on it) with body 0 as partner; node 6 keeps body 2, the
+        // nearer, alone: body 0 does not move with it.
+        assert_eq!(kept, [(5, 1, 0), (7, 1, 1), (6, 2, 2)]);
+        let five = out.pairs.iter().find(|p| p.node == 5).unwrap();
+        assert!(
+            (five.weight - 0.7).abs() < 1e-12,
+            "edges 10, 11, 12 once: {}",
+            five.weight
+        );
+        assert!(five.touching);
+        assert_eq!(out.spacing, vec![3.0, 4.0, 5.0]);
     }
 }

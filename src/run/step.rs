@@ -670,12 +670,12 @@ impl Simulation {
         let mut body_force = vec![[0.0; 2]; self.model.bodies.len()];
         let mut contact_state = super::contact::ContactState::new();
         for (c, law) in problem.contact_pairs().iter().zip(&laws) {
-            let b = &mut body_force[c.body as usize];
+            let b = &mut body_force[law.body as usize];
             b[0] -= law.force[0];
             b[1] -= law.force[1];
             if law.status != crate::rigid::Status::Free {
                 let key = node_key(mesh, dofs, c.node as usize);
-                contact_state.insert((key, c.body), [law.pressure, law.shear]);
+                contact_state.insert((key, law.body), [law.pressure, law.shear]);
             }
         }
         let du = problem.node_displacements(&local);

@@ -17,7 +17,7 @@ use crate::mesh::LocalMesh;
 use crate::petsc::matrix::{to_int, MatRef};
 use crate::petsc::snes::{CallbackError, NonlinearProblem};
 use crate::petsc::{Int, Mat, PVec, PetscError, Scatter, VecRef};
-use crate::rigid::{node_law, ContactPair, NodeLaw, Shape, Status};
+use crate::rigid::{node_law_among, ContactPair, NodeLaw, Shape, Status};
 use pfem_partition::{agree_on_error, Comm};
 use std::cell::{Cell, RefCell};
 
@@ -597,7 +597,7 @@ impl<'a> StepProblem<'a> {
         &self.setup.contact
     }
 
-    /// The contact law of every pair at `local` ([`node_law`]), from the soil's residual at
+    /// The contact law of every pair at `local` ([`node_law_among`]), from the soil's residual at
     /// its node: the triangles around the contact nodes, in increasing order as the full pass
     /// adds them, then the surface pressures and point loads. Every residual and Jacobian at
     /// one iterate so decides alike. A triangle that cannot be evaluated is left out: the full
@@ -631,14 +631,7 @@ impl<'a> StepProblem<'a> {
             .contact
             .iter()
             .zip(&r)
-            .map(|(c, &r)| {
-                node_law(
-                    c,
-                    &s.bodies[c.body as usize],
-                    self.node_u(local, c.node as usize),
-                    r,
-                )
-            })
+            .map(|(c, &r)| node_law_among(c, &s.bodies, self.node_u(local, c.node as usize), r))
             .collect();
         self.contact_seconds
             .set(self.contact_seconds.get() + clock.elapsed().as_secs_f64());
