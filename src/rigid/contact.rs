@@ -33,6 +33,9 @@ pub struct ContactPair {
     /// iterate. Where a node slides from one onto the other within an increment, a law against
     /// the first alone would pull it into the second, around the first one's hidden corner.
     pub partner: u32,
+    /// The partner's α·cu (Pa): a rough cone under a smooth shaft (the sleeve's friction is
+    /// not the cone's resistance) holds a node by the strength of the face it is on.
+    pub partner_shear_limit: f64,
     /// Node position at the start of the increment.
     pub start: [f64; 2],
     /// Boundary length the node stands for (m per metre).
@@ -117,9 +120,14 @@ pub fn node_law_among(pair: &ContactPair, shapes: &[Shape], u: [f64; 2], r: [f64
     } else {
         a
     };
-    let facing = ContactPair {
-        body: nearer,
-        ..*pair
+    let facing = if nearer == pair.body {
+        *pair
+    } else {
+        ContactPair {
+            body: nearer,
+            shear_limit: pair.partner_shear_limit,
+            ..*pair
+        }
     };
     node_law(&facing, &shapes[nearer as usize], u, r)
 }
@@ -250,6 +258,7 @@ mod tests {
             node: 0,
             body: 0,
             partner: 0,
+            partner_shear_limit: 0.0,
             start: [0.3, -0.96],
             weight: 0.05,
             constant: 1e6,
@@ -416,6 +425,22 @@ mod tests {
             ..p
         };
         assert_eq!(node_law_among(&swapped, &shapes, [0.0; 2], push), law);
+        // A rough shaft over a smooth cone: on the arc the node takes the shaft's strength
+        // (it sticks and carries the soil's shear), on the cone's face none.
+        let tangential = [push[0] - 100.0 * n[1], push[1] + 100.0 * n[0]];
+        let rough_shaft = ContactPair {
+            partner_shear_limit: 1e9,
+            ..p
+        };
+        let on_shaft = node_law_among(&rough_shaft, &shapes, [0.0; 2], tangential);
+        assert_eq!((on_shaft.status, on_shaft.body), (Status::Stick, 1));
+        assert!(
+            (on_shaft.shear.abs() - 100.0 / p.weight).abs() < 1e-6,
+            "{}",
+            on_shaft.shear
+        );
+        let smooth = node_law_among(&p, &shapes, [0.0; 2], tangential);
+        assert_eq!(smooth.shear, 0.0);
         let face = [0.5 * 0.928_18, 0.5 * 1.607_66];
         let below = ContactPair { start: face, ..p };
         let law = node_law_among(&below, &shapes, [0.0; 2], [346.4, -200.0]);

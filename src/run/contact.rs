@@ -193,6 +193,7 @@ impl Simulation {
                     node: n,
                     body: bi as u32,
                     partner: bi as u32,
+                    partner_shear_limit: body.shear_limit,
                     start: x,
                     weight: w,
                     constant: model.scene.contact.penalty * young / h,
@@ -216,9 +217,10 @@ impl Simulation {
 
 /// A node near two bodies holds its rows for one law only: it keeps the pair of the body it
 /// starts nearest to (the lower body index on a tie), so that the choice does not depend on
-/// the partition. When the other body moves with it (the same increment and interface: a cone
+/// the partition. When the other body moves with it (the same increment and suction: a cone
 /// and the shaft above it), that body becomes the pair's partner, the node is held against
-/// their union, and it stands for the boundary edges facing either.
+/// their union (by the strength of the face it is on), and it stands for the boundary edges
+/// facing either.
 fn join_bodies(out: &mut BoundaryLoads, start_distance: &[f64], facing: &[Vec<(usize, f64)>]) {
     let mut best: HashMap<u32, usize> = HashMap::new();
     for (i, pair) in out.pairs.iter().enumerate() {
@@ -234,9 +236,7 @@ fn join_bodies(out: &mut BoundaryLoads, start_distance: &[f64], facing: &[Vec<(u
         return;
     }
     let together = |a: &ContactPair, b: &ContactPair| {
-        a.body_increment == b.body_increment
-            && a.shear_limit == b.shear_limit
-            && a.suction == b.suction
+        a.body_increment == b.body_increment && a.suction == b.suction
     };
     // The nearest other pair of the same node whose body moves with the kept one.
     let mut partner: HashMap<u32, usize> = HashMap::new();
@@ -262,11 +262,12 @@ fn join_bodies(out: &mut BoundaryLoads, start_distance: &[f64], facing: &[Vec<(u
                 .iter()
                 .filter(|e| !facing[b].iter().any(|f| f.0 == e.0)),
         );
-        let (other_body, other_touching) = (out.pairs[p].body, out.pairs[p].touching);
+        let other = out.pairs[p];
         let kept = &mut out.pairs[b];
-        kept.partner = other_body;
+        kept.partner = other.body;
+        kept.partner_shear_limit = other.shear_limit;
         kept.weight = edges.iter().map(|e| e.1).sum();
-        kept.touching |= other_touching;
+        kept.touching |= other.touching;
     }
     let keep: Vec<bool> = (0..out.pairs.len())
         .map(|i| best[&out.pairs[i].node] == i)
@@ -537,6 +538,7 @@ mod tests {
             node,
             body,
             partner: body,
+            partner_shear_limit: 0.0,
             start: [0.0; 2],
             weight: 0.0,
             constant: 1.0,
@@ -564,6 +566,7 @@ mod tests {
             surface: Vec::new(),
             surface_edges: Vec::new(),
         };
+        out.pairs[0].shear_limit = 7.0;
         let start = [0.02, 0.01, 0.0, 0.5, -0.001];
         let facing = [
             vec![(10, 0.1), (11, 0.2)],
@@ -588,6 +591,10 @@ mod tests {
             five.weight
         );
         assert!(five.touching);
+        assert_eq!(
+            five.partner_shear_limit, 7.0,
+            "the partner's interface comes along"
+        );
         assert_eq!(out.spacing, vec![3.0, 4.0, 5.0]);
     }
 }
