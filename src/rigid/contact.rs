@@ -19,7 +19,7 @@
 //! The complementarity constant c only weighs pressure against gap in the decision while
 //! Newton is away from the solution: the converged pressures and gaps do not depend on it.
 
-use super::shape::Shape;
+use super::shape::{Proximity, Shape};
 
 /// One soil node facing one rigid body in an increment.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -114,11 +114,11 @@ pub fn node_law_among(pair: &ContactPair, shapes: &[Shape], u: [f64; 2], r: [f64
         return node_law(pair, &shapes[a as usize], u, r);
     }
     let x = [pair.start[0] + u[0], pair.start[1] + u[1]];
-    let nearer = if shapes[b as usize].closest(x).distance < shapes[a as usize].closest(x).distance
-    {
-        b
+    let (near_a, near_b) = (shapes[a as usize].closest(x), shapes[b as usize].closest(x));
+    let (nearer, prox) = if near_b.distance < near_a.distance {
+        (b, near_b)
     } else {
-        a
+        (a, near_a)
     };
     let facing = if nearer == pair.body {
         *pair
@@ -129,14 +129,18 @@ pub fn node_law_among(pair: &ContactPair, shapes: &[Shape], u: [f64; 2], r: [f64
             ..*pair
         }
     };
-    node_law(&facing, &shapes[nearer as usize], u, r)
+    law_at(&facing, &prox, u, r)
 }
 
 /// The law of `pair` at its increment displacement `u`, against `shape` (its body at the end
 /// of the increment), where the soil's residual at the node is `r`.
 pub fn node_law(pair: &ContactPair, shape: &Shape, u: [f64; 2], r: [f64; 2]) -> NodeLaw {
     let x = [pair.start[0] + u[0], pair.start[1] + u[1]];
-    let prox = shape.closest(x);
+    law_at(pair, &shape.closest(x), u, r)
+}
+
+/// [`node_law`] with the body's proximity at the node's position already found.
+fn law_at(pair: &ContactPair, prox: &Proximity, u: [f64; 2], r: [f64; 2]) -> NodeLaw {
     let n = prox.normal;
     let t = [-n[1], n[0]];
     let kappa = prox.curvature;
