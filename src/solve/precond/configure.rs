@@ -69,6 +69,12 @@ pub fn configure(
             // the cantilever at h = 1/32: LU 9.8 M entries and 0.95 GFlop against PORD's
             // 10.6 M and 1.14 GFlop (AMD, QAMD: 11.3 M, 1.51 GFlop), LDLᵀ 5.0 M against 5.3 M.
             set_default("-mat_mumps_icntl_7", "2")?;
+            // No scaling: MUMPS's automatic choice (ICNTL(8) = 7 here) computes a row and
+            // column scaling at every numeric factorisation, and our rows are already of one
+            // size (a constrained row takes the mean free diagonal, a contact row E/h). The
+            // rigid-body built-ins factor 16-18 % faster with the same Newton iterations and
+            // histories to 2e-12 (bench/VALIDATION.md, seventeenth session).
+            set_default("-mat_mumps_icntl_8", "0")?;
             pc.set_factor_package("mumps")?;
             Ok(None)
         }
