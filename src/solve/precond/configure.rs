@@ -72,7 +72,7 @@ pub fn configure(
             // No scaling: MUMPS's automatic choice (ICNTL(8) = 7 here) computes a row and
             // column scaling at every numeric factorisation, and our rows are already of one
             // size (a constrained row takes the mean free diagonal, a contact row E/h). The
-            // rigid-body built-ins factor 10-18 % faster with the same Newton iterations and
+            // rigid-body built-ins run 10-18 % faster with the same Newton iterations and
             // histories to 2e-12 (bench/VALIDATION.md, seventeenth session).
             set_default("-mat_mumps_icntl_8", "0")?;
             pc.set_factor_package("mumps")?;
