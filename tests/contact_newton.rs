@@ -71,8 +71,8 @@ fn rough_tbar_same_curve_on_one_two_three_ranks() {
         let newton = newton_iterations(&log);
         println!("{ranks} ranks: {newton} Newton iterations in 4 steps");
         // Measured: 39 (20, 9, 7, 3) on 1, 2 and 3 ranks with the scene's Newton tolerance of
-        // 1e-3 (45 at 1e-6, which this bound refuses); the first step starts from no predictor. The augmentation loop
-        // took 246 for twice these steps (30.8 a step).
+        // 1e-3 (45 at 1e-6, which this bound refuses); the first step starts from no
+        // predictor. The augmentation loop took 246 for twice these steps (30.8 a step).
         assert!(newton <= 42, "{newton} Newton iterations");
     }
     println!("Nc: {:?}", column(&dir, "r1", "Nc"));
