@@ -27,11 +27,13 @@ mod error;
 mod fill;
 mod fill_boundary;
 #[cfg(test)]
+#[path = "tests/fill.rs"]
 mod fill_tests;
 mod gmsh;
 mod gmsh_header;
 mod gmsh_import;
 #[cfg(test)]
+#[path = "tests/gmsh.rs"]
 mod gmsh_tests;
 mod index;
 mod locate;

@@ -246,5 +246,4 @@ impl Material for DruckerPrager {
 }
 
 #[cfg(test)]
-#[path = "drucker_prager_tests.rs"]
 mod tests;

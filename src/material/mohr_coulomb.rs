@@ -371,5 +371,4 @@ impl Material for MohrCoulomb {
 }
 
 #[cfg(test)]
-#[path = "mohr_coulomb_tests.rs"]
 mod tests;

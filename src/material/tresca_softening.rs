@@ -454,5 +454,4 @@ impl Material for TrescaSoftening {
 }
 
 #[cfg(test)]
-#[path = "tresca_softening_tests.rs"]
 mod tests;
