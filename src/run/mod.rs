@@ -113,15 +113,10 @@ fn drive(
         .to_string();
     let mut out = output::Output::open(world, sim, &opts.out_dir)?;
     let progress = progress.insert(Progress::new(world, sim, opts)?);
-    // A line search given on the command line is set after the scene's, on every try.
-    let line_search = crate::petsc::options::string("-snes_linesearch_type")
-        .map_err(RunError::solver_option)?
-        .map(|ls| format!(" [-snes_linesearch_type {ls}: every try's line search is {ls}]"))
-        .unwrap_or_default();
-    progress.note(&format!(
-        "step solver: {}{line_search}",
-        step_solver::StepSolver::of(&sim.model, step::MAX_CUTS)
-    ));
+    let step_solver = step_solver::StepSolver::of(&sim.model, step::MAX_CUTS)
+        .with_command_line()
+        .map_err(RunError::solver_option)?;
+    progress.note(&format!("step solver: {step_solver}"));
     progress.note(&format!("linear solver: {linear}"));
     let mut last = opts.until_step.unwrap_or(u64::MAX).min(sim.total_steps());
     // The per-rank table after the end-of-run line: sizes of the last mesh, CPU of the solves.

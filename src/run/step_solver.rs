@@ -1,14 +1,17 @@
 //! How a step is solved, as one value chosen from the scene and printed at the start of a run.
 
 use crate::model::Model;
+use crate::petsc::error::PetscError;
 use crate::scene::LineSearch;
 
 /// The nonlinear method of every step.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct StepSolver {
     /// SNES line search, and the one a diverged piece is retried with.
     pub line_search: &'static str,
     pub retry: &'static str,
+    /// `-snes_linesearch_type` from the command line: set after the scene's, it is every try's.
+    pub command_line: Option<String>,
     /// Contact with rigid bodies, when there are any: decided inside every Newton iteration.
     pub contact: Option<ContactMethod>,
     /// Halvings of a step's increment before a divergence is final: the smallest piece is
@@ -41,12 +44,20 @@ impl StepSolver {
         StepSolver {
             line_search,
             retry,
+            command_line: None,
             contact: (!model.bodies.is_empty()).then_some(ContactMethod {
                 constant: c.penalty,
                 tolerance: c.tolerance,
             }),
             max_cuts,
         }
+    }
+
+    /// Collective (PETSc's options are the same on every rank). With the line search the
+    /// command line gives, if any.
+    pub fn with_command_line(mut self) -> Result<StepSolver, PetscError> {
+        self.command_line = crate::petsc::options::string("-snes_linesearch_type")?;
+        Ok(self)
     }
 
     /// The line search of a try: the retry's after a divergence.
@@ -61,12 +72,20 @@ impl StepSolver {
 
 impl std::fmt::Display for StepSolver {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.command_line {
+            Some(ls) => write!(
+                f,
+                "Newton, line search {ls} (-snes_linesearch_type, on every try"
+            )?,
+            None => write!(
+                f,
+                "Newton, line search {} (a diverged piece retried with {}",
+                self.line_search, self.retry
+            )?,
+        }
         write!(
             f,
-            "Newton, line search {} (a diverged piece retried with {}, then halved down to 1/{} \
-             of the step)",
-            self.line_search,
-            self.retry,
+            ", then halved down to 1/{} of the step)",
             1u64 << self.max_cuts
         )?;
         if let Some(c) = self.contact {
