@@ -100,8 +100,9 @@ pub struct Contact {
     /// never converged (tests/contact.rs, the stick step).
     pub penalty: f64,
     /// A converged increment must hold every touching node on the body's face, and keep every
-    /// free one out of it, to this fraction of its spacing, 1e-9 to 0.01; else a smaller
-    /// increment is tried. Default 1e-6.
+    /// free one out of it, to this fraction of its spacing, 1e-9 to 0.01; else Newton goes on
+    /// from there (at most twice, each time to `solver.newton_rtol` of the residual there),
+    /// then a smaller increment is tried. Default 1e-6.
     pub tolerance: f64,
     /// No longer read (it bounded the augmentation loop that Newton's active set replaced);
     /// accepted so that older scenes load, with a warning at `new`.
