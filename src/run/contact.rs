@@ -126,8 +126,8 @@ impl Simulation {
         let mut start_distance = Vec::new();
         // Each pair's boundary edges facing its body (edge index, the node's weight on it).
         let mut facing_edges: Vec<Vec<(usize, f64)>> = Vec::new();
-        // Nodes left out by the corner rule below, with their body's motion.
-        let mut cut_corners: Vec<(u32, u32, [f64; 2], f64, f64)> = Vec::new();
+        // Nodes left out by the corner rule below.
+        let mut cut_corners: Vec<CutCorner> = Vec::new();
         for (bi, body) in model.bodies.iter().enumerate() {
             let shape = &out.bodies[bi];
             let shape_from = body.shape(from);
@@ -181,7 +181,13 @@ impl Simulation {
                 // h²/8R only.)
                 let start = shape_from.closest(x).distance;
                 if start < -0.25 * shape_from.radius() - 1e-6 * h {
-                    cut_corners.push((n, bi as u32, inc, body.suction, body.shear_limit));
+                    cut_corners.push(CutCorner {
+                        node: n,
+                        body: bi as u32,
+                        increment: inc,
+                        suction: body.suction,
+                        shear_limit: body.shear_limit,
+                    });
                     continue;
                 }
                 let free = [0, 1].map(|c| !constraints.is_fixed(n as usize, c));
@@ -219,24 +225,34 @@ impl Simulation {
     }
 }
 
-/// A node left out at one body's corner (`cut`: node, body, the body's increment, suction and
-/// α·cu) but paired with a body moving with it is held against their union, as a node near both
-/// is ([`join_bodies`]). On the rough `cpt` a midside node 0.38 mm inside the cone's face beside
+/// A node the corner rule left out of one body's contact, with that body's motion and interface.
+#[derive(Debug, Clone, Copy)]
+struct CutCorner {
+    node: u32,
+    body: u32,
+    increment: [f64; 2],
+    suction: f64,
+    /// α·cu (Pa).
+    shear_limit: f64,
+}
+
+/// A node left out at one body's corner (`cut`) but paired with a body moving with it is held
+/// against their union, as a node near both is ([`join_bodies`]). On the rough `cpt` a midside node 0.38 mm inside the cone's face beside
 /// its hidden top corner (radius 0.5 mm) was left out of the cone but held against the shaft's
 /// arc alone, which the cone hides there, 0.26 mm inside it; Newton cycled between holding it
 /// and letting it go and stopped at z/D = 7.94.
-fn join_cut_corners(out: &mut BoundaryLoads, cut: &[(u32, u32, [f64; 2], f64, f64)]) {
+fn join_cut_corners(out: &mut BoundaryLoads, cut: &[CutCorner]) {
     for p in &mut out.pairs {
-        let with = cut.iter().find(|&&(n, b, inc, suction, _)| {
+        let with = cut.iter().find(|c| {
             p.partner == p.body
-                && n == p.node
-                && b != p.body
-                && inc == p.body_increment
-                && suction == p.suction
+                && c.node == p.node
+                && c.body != p.body
+                && c.increment == p.body_increment
+                && c.suction == p.suction
         });
-        if let Some(&(_, b, _, _, limit)) = with {
-            p.partner = b;
-            p.partner_shear_limit = limit;
+        if let Some(c) = with {
+            p.partner = c.body;
+            p.partner_shear_limit = c.shear_limit;
         }
     }
 }
@@ -520,7 +536,8 @@ fn node_info(
 #[cfg(test)]
 mod tests {
     use super::{
-        along_support, deepest, join_bodies, join_cut_corners, BoundaryLoads, PENETRATION_LIMIT,
+        along_support, deepest, join_bodies, join_cut_corners, BoundaryLoads, CutCorner,
+        PENETRATION_LIMIT,
     };
     use crate::rigid::{ContactPair, Shape};
 
@@ -588,7 +605,14 @@ mod tests {
             surface: Vec::new(),
             surface_edges: Vec::new(),
         };
-        join_cut_corners(&mut out, &[(5, 0, down, 0.0, 7.0), (6, 2, held, 0.0, 0.0)]);
+        let cut = |node: u32, body: u32, increment: [f64; 2], shear_limit: f64| CutCorner {
+            node,
+            body,
+            increment,
+            suction: 0.0,
+            shear_limit,
+        };
+        join_cut_corners(&mut out, &[cut(5, 0, down, 7.0), cut(6, 2, held, 0.0)]);
         let got: Vec<(u32, u32, u32, f64)> = out
             .pairs
             .iter()
