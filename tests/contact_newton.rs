@@ -135,24 +135,7 @@ fn the_default_smooth_tbar_is_the_same_on_one_two_three_ranks_to_round_off() {
 #[test]
 fn a_contact_gap_left_by_a_loose_newton_tolerance_is_closed_without_a_cut() {
     let dir = workdir("contact-newton-polish");
-    ok(
-        &dir,
-        1,
-        &[
-            "new",
-            "footing",
-            "-o",
-            "f.h5",
-            "--set",
-            "mesh.h=0.5",
-            "--set",
-            "mesh.fine=[{origin=[0.0,6.0],size=[4.0,4.0],h=0.25}]",
-            "--set",
-            "rigid[0].stages=[{to=[0.0,-0.8],steps=40}]",
-            "--set",
-            "rigid[0].polygon={vertices=[[-1.0,10.0],[1.0,10.0],[1.0,10.5],[-1.0,10.5]],corner_radius=0.02}",
-        ],
-    );
+    coarse_sharp_footing(&dir, 0.8, 40);
     ok(&dir, 1, &["f.h5", "--out", "r1"]);
     // The run's own log has every step's line.
     let log = std::fs::read_to_string(dir.join("r1").join("run.log")).unwrap();

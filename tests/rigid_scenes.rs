@@ -44,27 +44,7 @@ fn close(a: &[f64], b: &[f64], tol: f64) {
 #[ignore = "coarse benchmark: rigid footing against Prandtl, 20 steps on 1, 2 and 3 ranks"]
 fn footing_coarse_is_within_15_percent_of_prandtl_and_below_the_deep_limit() {
     let dir = workdir("footing-coarse");
-    ok(
-        &dir,
-        1,
-        &[
-            "new",
-            "footing",
-            "-o",
-            "f.h5",
-            "--set",
-            "mesh.h=0.5",
-            "--set",
-            "mesh.fine=[{origin=[0.0,6.0],size=[4.0,4.0],h=0.25}]",
-            "--set",
-            "rigid[0].stages=[{to=[0.0,-0.4],steps=20}]",
-            // The default edge radius (0.2 m) is nearly this coarse spacing (0.25 m): the 2-rank
-            // run then stops at z/B = 0.1 (open, bench/VALIDATION.md); the coarse check keeps
-            // the 1 % rounding of the earlier default.
-            "--set",
-            "rigid[0].polygon={vertices=[[-1.0,10.0],[1.0,10.0],[1.0,10.5],[-1.0,10.5]],corner_radius=0.02}",
-        ],
-    );
+    coarse_sharp_footing(&dir, 0.4, 20);
     let [r1, r2, r3] = on_ranks(&dir, "f.h5", [1, 2, 3]);
     let q = column(&dir, &r1, "q_over_cu");
     let z = column(&dir, &r1, "z_over_B");

@@ -265,6 +265,34 @@ pub trait Material: Send + Sync + fmt::Debug {
     }
 }
 
+/// Test helper: the Frobenius distance between `m`'s tangent at the strain increment `e` from
+/// `state` and central differences (step `h`) of its stress, relative to the tangent's norm or
+/// `floor`, whichever is larger (a zero tangent, as at a cone's apex, needs a floor such as E).
+#[cfg(test)]
+pub(crate) fn tangent_fd_error(
+    m: &dyn Material,
+    state: &GaussState,
+    e: &[f64; 4],
+    h: f64,
+    floor: f64,
+) -> f64 {
+    let r = m.update(state, e).expect("ok");
+    let (mut num, mut den) = (0.0, 0.0);
+    for j in 0..4 {
+        let (mut ep, mut em) = (*e, *e);
+        ep[j] += h;
+        em[j] -= h;
+        let sp = m.update(state, &ep).expect("ok").s;
+        let sm = m.update(state, &em).expect("ok").s;
+        for i in 0..4 {
+            let fd = (sp[i] - sm[i]) / (2.0 * h);
+            num += (fd - r.d[i][j]).powi(2);
+            den += r.d[i][j].powi(2);
+        }
+    }
+    (num / den.max(floor * floor)).sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -618,24 +618,7 @@ mod tests {
     }
 
     fn fd_check(m: &Tresca, st: &GaussState, e: &[f64; 4]) -> f64 {
-        let r = m.update(st, e).expect("ok");
-        let h = 1e-8;
-        let mut num = 0.0;
-        let mut den = 0.0;
-        for j in 0..4 {
-            let mut ep = *e;
-            let mut em = *e;
-            ep[j] += h;
-            em[j] -= h;
-            let sp = m.update(st, &ep).expect("ok").s;
-            let sm = m.update(st, &em).expect("ok").s;
-            for i in 0..4 {
-                let fd = (sp[i] - sm[i]) / (2.0 * h);
-                num += (fd - r.d[i][j]).powi(2);
-                den += r.d[i][j].powi(2);
-            }
-        }
-        (num / den).sqrt()
+        crate::material::tangent_fd_error(m, st, e, 1e-8, 0.0)
     }
 
     #[test]

@@ -541,6 +541,26 @@ mod tests {
     };
     use crate::rigid::{ContactPair, Shape};
 
+    /// A pair of `node` and `body` moving by `inc`, its partner itself, unit scales.
+    fn pair(node: u32, body: u32, inc: [f64; 2], touching: bool) -> ContactPair {
+        ContactPair {
+            node,
+            body,
+            partner: body,
+            partner_shear_limit: 0.0,
+            start: [0.0; 2],
+            weight: 0.0,
+            constant: 1.0,
+            row_scale: 1.0,
+            shear_limit: 0.0,
+            body_increment: inc,
+            offset: 0.0,
+            touching,
+            suction: 0.0,
+            free: [true, true],
+        }
+    }
+
     #[test]
     fn deepest_particle_is_measured_in_its_own_spacing() {
         let shapes = [
@@ -579,22 +599,7 @@ mod tests {
 
     #[test]
     fn a_node_left_out_at_a_corner_is_held_against_the_union_with_the_bodies_moving_with_it() {
-        let pair = |node: u32, body: u32, inc: [f64; 2]| ContactPair {
-            node,
-            body,
-            partner: body,
-            partner_shear_limit: 0.0,
-            start: [0.0; 2],
-            weight: 0.0,
-            constant: 1.0,
-            row_scale: 1.0,
-            shear_limit: 0.0,
-            body_increment: inc,
-            offset: 0.0,
-            touching: false,
-            suction: 0.0,
-            free: [true, true],
-        };
+        let pair = |node: u32, body: u32, inc: [f64; 2]| pair(node, body, inc, false);
         let (down, held) = ([0.0, -0.01], [0.0; 2]);
         // Bodies 0 and 1 move down together, body 2 is held. Node 5 was left out at body 0's
         // corner (α·cu 7), node 6 at body 2's.
@@ -625,22 +630,6 @@ mod tests {
 
     #[test]
     fn a_node_near_two_bodies_moved_together_holds_against_both() {
-        let pair = |node: u32, body: u32, inc: [f64; 2], touching: bool| ContactPair {
-            node,
-            body,
-            partner: body,
-            partner_shear_limit: 0.0,
-            start: [0.0; 2],
-            weight: 0.0,
-            constant: 1.0,
-            row_scale: 1.0,
-            shear_limit: 0.0,
-            body_increment: inc,
-            offset: 0.0,
-            touching,
-            suction: 0.0,
-            free: [true, true],
-        };
         let down = [0.0, -0.01];
         // Node 5 near bodies 0 and 1 (moved together), node 6 near bodies 0 and 2 (body 2 held),
         // node 7 near body 1 only. Edges 10-12 face the bodies: node 5's edge 11 faces both.

@@ -147,6 +147,32 @@ pub fn small_cantilever(dir: &Path, steps: u32, sets: &[&str]) {
     cantilever_case(dir, "0.25", steps, sets);
 }
 
+/// `pfem-mpi new footing -o f.h5` on a coarse cloud (0.5 m, 0.25 m within 4 m of the edge: B/8)
+/// with sharp edges (radius 1 % of B), pushed `depth` m in `steps` steps. The built-in's 0.2 m
+/// edge radius is nearly this coarse spacing: at it the 2-rank run stopped at z/B = 0.1
+/// (bench/VALIDATION.md).
+pub fn coarse_sharp_footing(dir: &Path, depth: f64, steps: u32) {
+    let stages = format!("rigid[0].stages=[{{to=[0.0,{}],steps={steps}}}]", -depth);
+    ok(
+        dir,
+        1,
+        &[
+            "new",
+            "footing",
+            "-o",
+            "f.h5",
+            "--set",
+            "mesh.h=0.5",
+            "--set",
+            "mesh.fine=[{origin=[0.0,6.0],size=[4.0,4.0],h=0.25}]",
+            "--set",
+            &stages,
+            "--set",
+            "rigid[0].polygon={vertices=[[-1.0,10.0],[1.0,10.0],[1.0,10.5],[-1.0,10.5]],corner_radius=0.02}",
+        ],
+    );
+}
+
 /// Runs the Python `body` with h5py and the HDF5 file open as `f` (read-only) and returns every
 /// line it printed as numbers.
 pub fn h5py_rows(file: &Path, body: &str) -> Vec<Vec<f64>> {

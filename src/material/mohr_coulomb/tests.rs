@@ -49,22 +49,7 @@ fn close3(a: &[f64; 3], b: &[f64; 3], tol: f64) {
 /// Frobenius distance between the tangent and central differences of the stress, relative to
 /// the tangent's norm or E, whichever is larger (the apex's tangent is zero).
 fn fd_error(m: &MohrCoulomb, st: &GaussState, e: &[f64; 4]) -> f64 {
-    let r = m.update(st, e).expect("ok");
-    let h = 1e-9;
-    let (mut num, mut den) = (0.0, 0.0);
-    for j in 0..4 {
-        let (mut ep, mut em) = (*e, *e);
-        ep[j] += h;
-        em[j] -= h;
-        let sp = m.update(st, &ep).expect("ok").s;
-        let sm = m.update(st, &em).expect("ok").s;
-        for i in 0..4 {
-            let fd = (sp[i] - sm[i]) / (2.0 * h);
-            num += (fd - r.d[i][j]).powi(2);
-            den += r.d[i][j].powi(2);
-        }
-    }
-    (num / den.max(m.young * m.young)).sqrt()
+    crate::material::tangent_fd_error(m, st, e, 1e-9, m.young)
 }
 
 #[test]
