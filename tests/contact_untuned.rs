@@ -17,7 +17,7 @@ fn column(dir: &Path, out: &str, name: &str) -> Vec<f64> {
 
 /// Runs the scene (with `sets`) to its end on 1 and 2 ranks; returns the 1-rank V/(B cu) and
 /// H/(B cu) after asserting that both runs took all 30 steps and the same path, and that the
-/// load at the end of the push is Prandtl's 2 + π (smooth or rough) within 5 %: with six
+/// load at the end of the push is that of a footing between the surface and B/6 deep: with six
 /// particles across B it scatters by ±4 % from step to step, so the mean of the push's last four
 /// steps (z = 0.07–0.1 m) is compared.
 fn both_stages_on_one_and_two_ranks(name: &str, sets: &[&str]) -> (Vec<f64>, Vec<f64>) {
@@ -48,11 +48,15 @@ fn both_stages_on_one_and_two_ranks(name: &str, sets: &[&str]) -> (Vec<f64>, Vec
             );
         }
     }
+    // By then the footing is d = 0.07–0.1 m deep (d/B up to 1/6): its load lies between
+    // Prandtl's on the surface and that times Salgado et al.'s (2004) depth factor
+    // 1 + 0.27 √(d/B) = 1.11, within the scatter of the coarse cloud (3 %).
     let prandtl = 2.0 + std::f64::consts::PI;
+    let embedded = prandtl * (1.0 + 0.27 * (1.0f64 / 6.0).sqrt());
     let push = v[6..10].iter().sum::<f64>() / 4.0;
     assert!(
-        (push - prandtl).abs() < 0.05 * prandtl,
-        "V/(B cu) {push} at the end of the push against {prandtl}"
+        push > 0.97 * prandtl && push < 1.03 * embedded,
+        "V/(B cu) {push} at the end of the push against {prandtl} (surface) to {embedded} (d = B/6)"
     );
     (v, h)
 }
@@ -61,7 +65,8 @@ fn both_stages_on_one_and_two_ranks(name: &str, sets: &[&str]) -> (Vec<f64>, Vec
 #[ignore = "coarse benchmark: untuned rough footing pushed and dragged on 1 and 2 ranks"]
 fn the_untuned_rough_footing_is_pushed_to_prandtls_load_and_dragged_on_one_and_two_ranks() {
     let (v, h) = both_stages_on_one_and_two_ranks("contact-untuned", &[]);
-    // At the end of the push: measured 5.250 (+2.1 % on Prandtl).
+    // At the end of the push: measured 5.404 (+5.1 % on Prandtl; 5.250 before the corners got
+    // their nodes).
     // Dragged at its depth d = B/6, the rough base slides on the clay (B cu) and the side faces
     // add Rankine's 2 cu d' each (passive in front, suction behind), d' the embedment with the
     // heave, at most 2d: H/(B cu) between 1 and 1 + 8 d/B = 2.33 once the base slides.

@@ -12,6 +12,8 @@ pub struct RigidBody {
     pub shear_limit: f64,
     /// Suction the interface carries before it separates (Pa, >= 0).
     pub suction: f64,
+    /// Whether the soil gets a node on each of the body's unresolved corners.
+    pub corner_nodes: bool,
     motion: Rigid,
     /// Steps of the whole run: load factor 1 is the end of the last step.
     steps: f64,
@@ -24,6 +26,7 @@ impl RigidBody {
             initial,
             shear_limit: spec.adhesion * cu,
             suction: spec.ambient_pressure,
+            corner_nodes: spec.polygon.as_ref().is_some_and(|p| p.corner_nodes),
             motion: spec.clone(),
             steps: steps as f64,
         }

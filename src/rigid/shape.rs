@@ -103,6 +103,29 @@ pub struct Shape {
     deep: (P, f64),
 }
 
+/// A polygon's corner: the arc of radius `radius` round a core vertex between the outward
+/// normals of the edges before and after it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Corner {
+    pub vertex: [f64; 2],
+    pub normals: [[f64; 2]; 2],
+    pub radius: f64,
+}
+
+impl Corner {
+    /// The angle through which the outline turns here (radians; negative where it turns in).
+    pub fn turn(&self) -> f64 {
+        let [a, b] = self.normals;
+        cross(a, b).atan2(dot(a, b))
+    }
+
+    /// The middle of the arc.
+    pub fn middle(&self) -> [f64; 2] {
+        let bis = add(self.normals[0], self.normals[1]);
+        add(self.vertex, mul(self.radius / norm(bis), bis))
+    }
+}
+
 /// Result of a closest-point query.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Proximity {
@@ -244,6 +267,21 @@ impl Shape {
     /// The core's points, counter-clockwise.
     pub fn core(&self) -> &[[f64; 2]] {
         &self.core
+    }
+
+    /// The corners of a polygon, one per core vertex (none for a circle).
+    pub fn corners(&self) -> Vec<Corner> {
+        let n = self.core.len();
+        if n < 3 {
+            return Vec::new();
+        }
+        (0..n)
+            .map(|i| Corner {
+                vertex: self.core[i],
+                normals: [self.edge_normal((i + n - 1) % n), self.edge_normal(i)],
+                radius: self.radius,
+            })
+            .collect()
     }
 
     fn edge_normal(&self, i: usize) -> P {

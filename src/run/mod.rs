@@ -4,6 +4,7 @@ mod adapt;
 mod axis;
 mod boundary_rules;
 mod contact;
+mod corners;
 mod curved_edges;
 mod error;
 mod geostatic;

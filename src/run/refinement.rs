@@ -84,9 +84,13 @@ impl Simulation {
             plan.split.clear();
             plan.remove.clear();
         }
+        let removing: HashSet<u32> = plan.remove.iter().copied().collect();
+        let corners = self.corner_moves(world, mesh, &removing);
+        plan.smooth
+            .retain(|(p, _)| !corners.iter().any(|(c, _)| c == p));
         let changes = sum_f64(
             world,
-            &[(plan.split.len() + plan.remove.len() + plan.smooth.len()) as f64],
+            &[(plan.split.len() + plan.remove.len() + plan.smooth.len() + corners.len()) as f64],
         )[0];
         if changes == 0.0 {
             return Ok(false);
@@ -119,6 +123,14 @@ impl Simulation {
         let mut smoothed = Vec::new();
         for &(p, target) in &plan.smooth {
             if let Some((state, u)) = sample_star(mesh, p as usize, target, &value, &disp) {
+                smoothed.push((p as usize, target, state, u));
+                moved.insert(mesh.gids[p as usize]);
+            }
+        }
+        // A corner's node takes the old field's values at the corner, which may lie just off
+        // the soil's boundary chord: the nearest point of the triangles around it.
+        for &(p, target) in &corners {
+            if let Some((state, u)) = sample_nearest(mesh, p as usize, target, &value, &disp) {
                 smoothed.push((p as usize, target, state, u));
                 moved.insert(mesh.gids[p as usize]);
             }
@@ -252,4 +264,44 @@ fn sample_star<'a>(
         }
     }
     None
+}
+
+/// Linear interpolation of particle values at the point nearest to `target` of the triangles
+/// around particle `p`: the one whose smallest barycentric coordinate at `target` is largest,
+/// its coordinates clipped to the triangle.
+fn sample_nearest<'a>(
+    mesh: &LocalMesh,
+    p: usize,
+    target: [f64; 2],
+    value: &impl Fn(usize) -> &'a [f64],
+    disp: &impl Fn(usize) -> [f64; 2],
+) -> Option<(Vec<f64>, [f64; 2])> {
+    let mut best: Option<([usize; 3], [f64; 3])> = None;
+    for t in mesh.tris.iter().filter(|t| t.contains(&(p as u32))) {
+        let [a, b, c] = t.map(|v| v as usize);
+        let bary = barycentric(mesh.points[a], mesh.points[b], mesh.points[c], target);
+        if !bary.iter().all(|l| l.is_finite()) {
+            continue;
+        }
+        let low = bary.iter().copied().fold(f64::INFINITY, f64::min);
+        if best.is_none_or(|(_, bb)| low > bb.iter().copied().fold(f64::INFINITY, f64::min)) {
+            best = Some(([a, b, c], bary));
+        }
+    }
+    let (tri, bary) = best?;
+    let clipped = bary.map(|l| l.max(0.0));
+    let sum: f64 = clipped.iter().sum();
+    if sum <= 0.0 {
+        return None;
+    }
+    let bary = clipped.map(|l| l / sum);
+    let vals = tri.map(value);
+    let mut state = vec![0.0; vals[0].len()];
+    for (l, v) in bary.iter().zip(vals) {
+        for (o, x) in state.iter_mut().zip(v) {
+            *o += l * x;
+        }
+    }
+    let u = interpolate_linear(bary, &tri.map(disp));
+    Some((state, u))
 }

@@ -67,6 +67,23 @@ pub struct Polygon {
     /// Radius of the rounded corners (m), default 0 (sharp).
     #[serde(default)]
     pub corner_radius: f64,
+    /// A mesh node on each corner that the soil wraps (default true): where the corner's
+    /// rounding is below the particle spacing, the boundary particle nearest to the corner
+    /// (within 0.3 spacing) is moved onto it at every remesh and takes the soil's state there,
+    /// so that the soil's boundary bends where the body does as the soil flows past. `false`
+    /// leaves a corner to the particles that pass it: for a corner whose soil falls away
+    /// behind it (a spudcan's rim, where the free surface beside the rim's top would be drawn
+    /// down with it).
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub corner_nodes: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+fn is_true(x: &bool) -> bool {
+    *x
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
