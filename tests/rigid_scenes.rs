@@ -44,7 +44,7 @@ fn close(a: &[f64], b: &[f64], tol: f64) {
 #[ignore = "coarse benchmark: rigid footing against Prandtl, 20 steps on 1, 2 and 3 ranks"]
 fn footing_coarse_is_within_15_percent_of_prandtl_and_below_the_deep_limit() {
     let dir = workdir("footing-coarse");
-    coarse_sharp_footing(&dir, 0.4, 20);
+    coarse_sharp_footing(&dir, 0.4, 20, true);
     let [r1, r2, r3] = on_ranks(&dir, "f.h5", [1, 2, 3]);
     let q = column(&dir, &r1, "q_over_cu");
     let z = column(&dir, &r1, "z_over_B");

@@ -148,11 +148,16 @@ pub fn small_cantilever(dir: &Path, steps: u32, sets: &[&str]) {
 }
 
 /// `pfem-mpi new footing -o f.h5` on a coarse cloud (0.5 m, 0.25 m within 4 m of the edge: B/8)
-/// with sharp edges (radius 1 % of B), pushed `depth` m in `steps` steps. The built-in's 0.2 m
+/// with sharp edges (radius 1 % of B; with or without the soil's node on each corner,
+/// `corner_nodes`), pushed `depth` m in `steps` steps. The built-in's 0.2 m
 /// edge radius is nearly this coarse spacing: at it the 2-rank run stopped at z/B = 0.1
 /// (bench/VALIDATION.md).
-pub fn coarse_sharp_footing(dir: &Path, depth: f64, steps: u32) {
+pub fn coarse_sharp_footing(dir: &Path, depth: f64, steps: u32, corner_nodes: bool) {
     let stages = format!("rigid[0].stages=[{{to=[0.0,{}],steps={steps}}}]", -depth);
+    let polygon = format!(
+        "rigid[0].polygon={{vertices=[[-1.0,10.0],[1.0,10.0],[1.0,10.5],[-1.0,10.5]],\
+         corner_radius=0.02,corner_nodes={corner_nodes}}}"
+    );
     ok(
         dir,
         1,
@@ -168,7 +173,7 @@ pub fn coarse_sharp_footing(dir: &Path, depth: f64, steps: u32) {
             "--set",
             &stages,
             "--set",
-            "rigid[0].polygon={vertices=[[-1.0,10.0],[1.0,10.0],[1.0,10.5],[-1.0,10.5]],corner_radius=0.02}",
+            &polygon,
         ],
     );
 }
