@@ -79,10 +79,11 @@ pub(super) fn nearest_candidate(
 impl Simulation {
     /// Collective. For every sharp corner of a rigid body at the current load factor (see
     /// [`sharp_corners`]), the owned boundary particle of `mesh` nearest to it within [`SNAP`]
-    /// of its spacing and the corner, unless a particle is on the corner already. Particles
-    /// held by a support, tracked, or in `removed` are not moved (a held one nearest to a
-    /// corner keeps it from the others). The nearest is chosen over all ranks (distance, then
-    /// global id), so the partition does not change the choice.
+    /// of its spacing and the corner, unless a particle is on the corner already; only bodies
+    /// with `corner_nodes`. Particles in `removed` (merged away by this refinement) are left
+    /// out; one held by a support or tracked is not moved, and being nearest it keeps the
+    /// corner from the others. The nearest is chosen over all ranks (distance, then global
+    /// id), so the partition does not change the choice.
     pub(super) fn corner_moves(
         &self,
         world: &Comm,

@@ -252,15 +252,7 @@ fn sample_star<'a>(
         let [a, b, c] = t.map(|v| v as usize);
         let bary = barycentric(mesh.points[a], mesh.points[b], mesh.points[c], target);
         if bary.iter().all(|&l| l.is_finite() && l >= -1e-12) {
-            let vals = [value(a), value(b), value(c)];
-            let mut state = vec![0.0; vals[0].len()];
-            for (l, v) in bary.iter().zip(vals) {
-                for (o, x) in state.iter_mut().zip(v) {
-                    *o += l * x;
-                }
-            }
-            let u = interpolate_linear(bary, &[disp(a), disp(b), disp(c)]);
-            return Some((state, u));
+            return Some(sample_at([a, b, c], bary, value, disp));
         }
     }
     None
@@ -294,7 +286,16 @@ fn sample_nearest<'a>(
     if sum <= 0.0 {
         return None;
     }
-    let bary = clipped.map(|l| l / sum);
+    Some(sample_at(tri, clipped.map(|l| l / sum), value, disp))
+}
+
+/// The state and displacement at barycentric coordinates `bary` of triangle `tri`.
+fn sample_at<'a>(
+    tri: [usize; 3],
+    bary: [f64; 3],
+    value: &impl Fn(usize) -> &'a [f64],
+    disp: &impl Fn(usize) -> [f64; 2],
+) -> (Vec<f64>, [f64; 2]) {
     let vals = tri.map(value);
     let mut state = vec![0.0; vals[0].len()];
     for (l, v) in bary.iter().zip(vals) {
@@ -302,6 +303,5 @@ fn sample_nearest<'a>(
             *o += l * x;
         }
     }
-    let u = interpolate_linear(bary, &tri.map(disp));
-    Some((state, u))
+    (state, interpolate_linear(bary, &tri.map(disp)))
 }
