@@ -248,14 +248,27 @@ fn sample_star<'a>(
     value: &impl Fn(usize) -> &'a [f64],
     disp: &impl Fn(usize) -> [f64; 2],
 ) -> Option<(Vec<f64>, [f64; 2])> {
-    for t in mesh.tris.iter().filter(|t| t.contains(&(p as u32))) {
-        let [a, b, c] = t.map(|v| v as usize);
-        let bary = barycentric(mesh.points[a], mesh.points[b], mesh.points[c], target);
-        if bary.iter().all(|&l| l.is_finite() && l >= -1e-12) {
-            return Some(sample_at([a, b, c], bary, value, disp));
-        }
-    }
-    None
+    let (tri, bary) =
+        star_coordinates(mesh, p, target).find(|(_, l)| l.iter().all(|&l| l >= -1e-12))?;
+    Some(sample_at(tri, bary, value, disp))
+}
+
+/// The triangles around particle `p` with the barycentric coordinates of `target` in each,
+/// where they are finite.
+fn star_coordinates(
+    mesh: &LocalMesh,
+    p: usize,
+    target: [f64; 2],
+) -> impl Iterator<Item = ([usize; 3], [f64; 3])> + '_ {
+    mesh.tris
+        .iter()
+        .filter(move |t| t.contains(&(p as u32)))
+        .map(move |t| {
+            let [a, b, c] = t.map(|v| v as usize);
+            let bary = barycentric(mesh.points[a], mesh.points[b], mesh.points[c], target);
+            ([a, b, c], bary)
+        })
+        .filter(|(_, l)| l.iter().all(|l| l.is_finite()))
 }
 
 /// Linear interpolation of particle values at the point nearest to `target` of the triangles
@@ -268,16 +281,11 @@ fn sample_nearest<'a>(
     value: &impl Fn(usize) -> &'a [f64],
     disp: &impl Fn(usize) -> [f64; 2],
 ) -> Option<(Vec<f64>, [f64; 2])> {
+    let lowest = |l: &[f64; 3]| l.iter().copied().fold(f64::INFINITY, f64::min);
     let mut best: Option<([usize; 3], [f64; 3])> = None;
-    for t in mesh.tris.iter().filter(|t| t.contains(&(p as u32))) {
-        let [a, b, c] = t.map(|v| v as usize);
-        let bary = barycentric(mesh.points[a], mesh.points[b], mesh.points[c], target);
-        if !bary.iter().all(|l| l.is_finite()) {
-            continue;
-        }
-        let low = bary.iter().copied().fold(f64::INFINITY, f64::min);
-        if best.is_none_or(|(_, bb)| low > bb.iter().copied().fold(f64::INFINITY, f64::min)) {
-            best = Some(([a, b, c], bary));
+    for (tri, bary) in star_coordinates(mesh, p, target) {
+        if best.is_none_or(|(_, b)| lowest(&bary) > lowest(&b)) {
+            best = Some((tri, bary));
         }
     }
     let (tri, bary) = best?;
