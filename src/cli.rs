@@ -195,13 +195,17 @@ pub fn parse(args: &[String]) -> Result<Command, String> {
 }
 
 /// Default output folder: the case's name with `.out` (`runs/case.h5` -> `runs/case.out`); a
-/// checkpoint `X.out/checkpoints/step_N.h5` continues in `X.out`.
+/// checkpoint `X.out/checkpoints/step_N.h5` continues in `X.out` (`checkpoints/step_N.h5`, given
+/// from inside the run folder, in `.`: an empty path would name no folder in messages).
 pub fn default_out_dir(case: &std::path::Path) -> PathBuf {
     if let Some(dir) = case
         .parent()
         .filter(|d| d.file_name().is_some_and(|n| n == "checkpoints"))
     {
         if let Some(run_dir) = dir.parent() {
+            if run_dir.as_os_str().is_empty() {
+                return PathBuf::from(".");
+            }
             return run_dir.to_path_buf();
         }
     }
@@ -328,6 +332,10 @@ mod tests {
         assert_eq!(
             default_out_dir("a/case.out/checkpoints/step_000010.h5".as_ref()),
             PathBuf::from("a/case.out")
+        );
+        assert_eq!(
+            default_out_dir("checkpoints/step_000010.h5".as_ref()),
+            PathBuf::from(".")
         );
     }
 }

@@ -96,6 +96,9 @@ fn material_of(
             if analysis.has_hoop() {
                 t = t.in_principal_stresses();
             }
+            if let Some(rho) = m.edge_rounding {
+                t = t.with_edge_rounding(rho)?;
+            }
             match (m.cu_gradient, m.reference_level) {
                 (k, Some(level)) if k != 0.0 => {
                     Box::new(t.with_profile(CuProfile { gradient: k, level }))

@@ -11,13 +11,20 @@
 //! a smooth criterion whose tangent keeps a stiffness ~ (1/2G + Δλ/δ)⁻¹ along the edge.
 //!
 //! # Criterion
-//! f(σ) = g(σ) − 2cu with g = ½ Σ_{i<j} h(σi − σj) and h(x) = √(x² + δ²), δ = [`ROUNDING`] cu.
+//! f(σ) = g(σ) − 2cu with g = ½ Σ_{i<j} h(σi − σj) and h(x) = √(x² + δ²), δ = ρ cu (ρ: the material's
+//! `edge_rounding`, [`DEFAULT_ROUNDING`] unless the scene sets it).
 //! Because |σ1 − σ2| + |σ2 − σ3| + |σ1 − σ3| = 2 (σmax − σmin), g is Tresca's σmax − σmin with
 //! each |·| smoothed: symmetric in the principal values (an isotropic function, smooth across
 //! their ties), convex, and pressure-independent (its gradient sums to zero, so associated flow
 //! is isochoric). On a face away from the edges (all differences ≫ δ) it is Tresca's to
-//! O(δ²/cu): 2.5e-5 cu at δ = 0.01 cu. On an edge the strength is lower by δ/2 of 2cu, 0.25 %
-//! ([`edge_strength`] gives it exactly).
+//! O(δ²/cu): 2.5e-5 cu at δ = 0.01 cu. On an edge the strength is lower by δ/2 of 2cu, ρ/4
+//! (0.25 % at ρ = 0.01; [`edge_strength`] gives it exactly).
+//!
+//! # Why a parameter
+//! A penetrometer's tip holds its whole plastic zone near the axis on the edge. There the
+//! return's tangent along the edge scales with δ: on a fine cloud (the cone at D/8.6) Newton
+//! stalled at free nodes under the tip with δ = 0.01 cu and went on with 0.05 cu. A wider
+//! rounding buys that robustness with a weaker edge (ρ/4), so the scene chooses it.
 //!
 //! # Return
 //! Associated flow with isotropic elasticity: σ = σ_tr − 2G Δλ ∇g(σ) (D∇g = 2G∇g because ∇g is
@@ -28,9 +35,11 @@
 use super::principal::solve_small;
 use super::MaterialError;
 
-/// δ / cu: the rounding's size. 0.25 % of the strength on an edge; the tangent's stiffness
-/// along an edge grows with it.
-pub const ROUNDING: f64 = 0.01;
+/// δ / cu by default: 0.25 % of the strength on an edge; the tangent's stiffness along an
+/// edge grows with it.
+pub const DEFAULT_ROUNDING: f64 = 0.01;
+/// The widest rounding a material may ask for: 2.5 % weaker on an edge.
+pub const MAX_ROUNDING: f64 = 0.1;
 /// Newton iterations of the return before it is reported as failed.
 const MAX_ITERATIONS: usize = 60;
 
@@ -70,21 +79,22 @@ fn relaxed(hess: &[[f64; 3]; 3], k: f64) -> [[f64; 3]; 3] {
 }
 
 /// The largest |σ1 − σ3| the rounded prism admits on an edge (two equal principal stresses):
-/// 2cu less about δ/2.
-pub fn edge_strength(cu: f64) -> f64 {
-    let d = ROUNDING * cu;
+/// 2cu less about δ/2, δ = `rounding` · cu.
+pub fn edge_strength(cu: f64, rounding: f64) -> f64 {
+    let d = rounding * cu;
     ((2.0 * cu - 0.5 * d).powi(2) - d * d).sqrt()
 }
 
 /// The return of principal trial stresses `tr` (any order) onto the rounded prism of strength
-/// `cu` with shear modulus `shear`: None when elastic, else the returned principal stresses (same
-/// order) and their derivatives by the trial's.
+/// `cu`, edges rounded by `rounding` · cu, with shear modulus `shear`: None when elastic, else
+/// the returned principal stresses (same order) and their derivatives by the trial's.
 pub fn principal_return(
     tr: &[f64; 3],
     shear: f64,
     cu: f64,
+    rounding: f64,
 ) -> Result<Option<Returned>, MaterialError> {
-    let d = ROUNDING * cu;
+    let d = rounding * cu;
     let (g_tr, _, _) = criterion(tr, d);
     if g_tr <= 2.0 * cu {
         return Ok(None);
@@ -190,53 +200,84 @@ mod tests {
 
     const CU: f64 = 5.0e3;
     const G: f64 = 100.0 * CU;
+    const ROUNDINGS: [f64; 3] = [DEFAULT_ROUNDING, 0.05, MAX_ROUNDING];
 
     #[test]
     fn on_a_face_far_from_the_edges_it_is_tresca_to_the_rounding_squared() {
         let tr = [3.0 * CU, 0.2 * CU, -3.0 * CU];
-        let (s, _) = principal_return(&tr, G, CU).unwrap().unwrap();
-        let diff = (s[0] - s[2]) / (2.0 * CU);
-        assert!((diff - 1.0).abs() < 2.0 * ROUNDING * ROUNDING, "{diff}");
-        // Isochoric: the mean is kept.
-        let m = |v: &[f64; 3]| v.iter().sum::<f64>() / 3.0;
-        assert!((m(&s) - m(&tr)).abs() < 1e-12 * CU);
+        for rho in ROUNDINGS {
+            let (s, _) = principal_return(&tr, G, CU, rho).unwrap().unwrap();
+            let diff = (s[0] - s[2]) / (2.0 * CU);
+            assert!((diff - 1.0).abs() < 2.0 * rho * rho, "{rho}: {diff}");
+            // Isochoric: the mean is kept.
+            let m = |v: &[f64; 3]| v.iter().sum::<f64>() / 3.0;
+            assert!((m(&s) - m(&tr)).abs() < 1e-12 * CU);
+        }
     }
 
     #[test]
     fn on_an_edge_the_strength_is_the_stated_edge_strength() {
         let tr = [CU, CU, -5.0 * CU];
-        let (s, _) = principal_return(&tr, G, CU).unwrap().unwrap();
-        assert!((s[0] - s[1]).abs() < 1e-12 * CU);
-        assert!(
-            ((s[0] - s[2]) - edge_strength(CU)).abs() < 1e-10 * CU,
-            "{s:?}"
-        );
-        let (g, _, _) = criterion(&s, ROUNDING * CU);
-        assert!((g - 2.0 * CU).abs() < 1e-10 * CU);
+        for rho in ROUNDINGS {
+            let (s, _) = principal_return(&tr, G, CU, rho).unwrap().unwrap();
+            assert!((s[0] - s[1]).abs() < 1e-12 * CU);
+            assert!(
+                ((s[0] - s[2]) - edge_strength(CU, rho)).abs() < 1e-10 * CU,
+                "{rho}: {s:?}"
+            );
+            let (g, _, _) = criterion(&s, rho * CU);
+            assert!((g - 2.0 * CU).abs() < 1e-10 * CU);
+            // About ρ/4 weaker than the prism's 2cu.
+            let weaker = 1.0 - edge_strength(CU, rho) / (2.0 * CU);
+            assert!(
+                (weaker - rho / 4.0).abs() < 0.1 * rho / 4.0,
+                "{rho}: {weaker}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_wider_rounding_stiffens_the_tangent_along_an_edge() {
+        // Drawing σ1 and σ2 apart on an edge, the exact prism's tangent has no stiffness
+        // (every such trial returns to the corner); the rounded one keeps some, more with a
+        // wider rounding.
+        let tr = [1.5 * CU, 1.5 * CU, -5.0 * CU];
+        let along = [1.0, -1.0, 0.0];
+        let stiffness = |rho: f64| {
+            let (_, ds) = principal_return(&tr, G, CU, rho).unwrap().unwrap();
+            (0..3)
+                .map(|i| along[i] * (0..3).map(|j| ds[i][j] * along[j]).sum::<f64>())
+                .sum::<f64>()
+        };
+        let (narrow, wide) = (stiffness(0.01), stiffness(0.05));
+        assert!(narrow > 0.0 && wide > 2.0 * narrow, "{narrow} {wide}");
     }
 
     #[test]
     fn tangent_matches_finite_differences_near_and_on_an_edge() {
-        for tr in [
+        for (tr, rho) in [
             [CU, CU, -5.0 * CU],
             [1.01 * CU, CU, -4.0 * CU],
             [2.0 * CU, 1.0 * CU, -1.5 * CU],
             [3.0 * CU, -2.0 * CU, -2.0001 * CU],
-        ] {
-            let (_, ds) = principal_return(&tr, G, CU).unwrap().unwrap();
+        ]
+        .into_iter()
+        .flat_map(|tr| ROUNDINGS.map(|rho| (tr, rho)))
+        {
+            let (_, ds) = principal_return(&tr, G, CU, rho).unwrap().unwrap();
             for j in 0..3 {
                 let eps = 1e-6 * CU;
                 let mut p = tr;
                 let mut m = tr;
                 p[j] += eps;
                 m[j] -= eps;
-                let sp = principal_return(&p, G, CU).unwrap().unwrap().0;
-                let sm = principal_return(&m, G, CU).unwrap().unwrap().0;
+                let sp = principal_return(&p, G, CU, rho).unwrap().unwrap().0;
+                let sm = principal_return(&m, G, CU, rho).unwrap().unwrap().0;
                 for i in 0..3 {
                     let fd = (sp[i] - sm[i]) / (2.0 * eps);
                     assert!(
                         (fd - ds[i][j]).abs() < 1e-6,
-                        "{tr:?} {i}{j}: {fd} vs {}",
+                        "{tr:?} {rho} {i}{j}: {fd} vs {}",
                         ds[i][j]
                     );
                 }
@@ -247,6 +288,8 @@ mod tests {
     #[test]
     fn inside_it_is_elastic() {
         let tr = [CU, 0.0, -0.9 * CU];
-        assert!(principal_return(&tr, G, CU).unwrap().is_none());
+        for rho in ROUNDINGS {
+            assert!(principal_return(&tr, G, CU, rho).unwrap().is_none());
+        }
     }
 }

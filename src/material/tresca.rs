@@ -98,6 +98,9 @@ pub struct Tresca {
     /// Judged in full principal stresses, σzz among them ([`Tresca::in_principal_stresses`]);
     /// false: the in-plane criterion of the module docs.
     pub principal: bool,
+    /// In full principal stresses: the prism's edges rounded by this fraction of cu
+    /// ([`super::rounded_prism`]; [`rounded_prism::DEFAULT_ROUNDING`] unless set).
+    pub edge_rounding: f64,
 }
 
 /// Deviatoric projector on Voigt vectors, engineering shear on the strain side (tensor shear
@@ -138,12 +141,14 @@ impl Tresca {
             profile: None,
             young_over_cu: None,
             principal: false,
+            edge_rounding: rounded_prism::DEFAULT_ROUNDING,
         })
     }
 
     /// The same material judged in full principal stresses: (σ1 − σ3)/2 = cu with σzz among
-    /// them, the prism's edges rounded by 1 % of cu ([`super::rounded_prism`]: 0.25 % weaker
-    /// on an edge, Tresca's to 2.5e-5 cu on a face away from them). Axisymmetry needs
+    /// them, the prism's edges rounded by `edge_rounding` · cu ([`super::rounded_prism`]: at
+    /// the default 1 %, 0.25 % weaker on an edge, Tresca's to 2.5e-5 cu on a face away from
+    /// them). Axisymmetry needs
     /// it: there σzz is the hoop stress, which can be the largest or the smallest, and plastic
     /// flow strains the hoop. In plane strain the in-plane criterion stays the default, since
     /// it holds the textbook collapse loads exactly from the first plastic step.
@@ -152,6 +157,22 @@ impl Tresca {
             principal: true,
             ..self
         }
+    }
+
+    /// The same material with the prism's edges rounded by `rounding` · cu in full principal
+    /// stresses, 0 < rounding ≤ [`rounded_prism::MAX_ROUNDING`].
+    pub fn with_edge_rounding(self, rounding: f64) -> Result<Self, MaterialError> {
+        if !(rounding > 0.0 && rounding <= rounded_prism::MAX_ROUNDING) {
+            return Err(MaterialError::InvalidParameter {
+                name: "edge_rounding",
+                value: rounding,
+                requirement: "0 < edge_rounding <= 0.1",
+            });
+        }
+        Ok(Self {
+            edge_rounding: rounding,
+            ..self
+        })
     }
 
     /// The same material with a strength profile: each point's cu is set from the height `y` it
@@ -370,8 +391,12 @@ impl Tresca {
             state.internal.resize(len, 0.0);
         }
         let frame = Spectral::of(&trial.s);
-        let Some((values, dv)) =
-            rounded_prism::principal_return(&frame.values, self.shear_modulus(), cu)?
+        let Some((values, dv)) = rounded_prism::principal_return(
+            &frame.values,
+            self.shear_modulus(),
+            cu,
+            self.edge_rounding,
+        )?
         else {
             return Ok(MaterialResponse {
                 s: trial.s,

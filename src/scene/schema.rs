@@ -468,6 +468,14 @@ pub struct Material {
     /// element's bulk modulus follows point by point. Default: one `young` everywhere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub young_over_cu: Option<f64>,
+    /// `"tresca"` in `analysis = "axisymmetric"` only, where the hoop stress is one of the
+    /// principal stresses the criterion judges: the rounding δ/cu of the edges of Tresca's
+    /// prism (σr = σθ on the axis puts a penetrometer's plastic zone on an edge), in (0, 0.1].
+    /// The edge is ρ/4 weaker than 2cu; a wider rounding gives Newton a stiffer tangent there.
+    /// Default 0.01 (0.25 % weaker); the cone penetrometer on a fine cloud needs 0.05
+    /// (docs/validation/cpt.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edge_rounding: Option<f64>,
     /// `"tresca-softening"` only: δ_rem, the remoulded strength over the intact one, in (0, 1]
     /// (1: no softening). Required.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -517,3 +517,44 @@ fn a_summed_force_names_bodies_that_exist() {
     );
     assert!(e.to_string().contains("names no"), "{e}");
 }
+
+#[test]
+fn edge_rounding_belongs_to_axisymmetric_tresca_and_names_its_field() {
+    let load = |name: &str, set: &str| load_scene(name, &[set.to_string()]).map(|(s, _)| s);
+    let ball = load("ball", "material.edge_rounding=0.05").expect("valid");
+    assert_eq!(ball.material.edge_rounding, Some(0.05));
+    // It reaches the model: squeezed axially with σr = σθ, the stress ends on the edge of
+    // the prism rounded by 5 %.
+    let model = crate::model::materials_of(&ball).expect("builds");
+    let cu = ball.material.cu;
+    let e = 50.0 * cu / ball.material.young;
+    let out = model[0]
+        .update(
+            &crate::material::GaussState::stressed([0.0; 4], 0),
+            &[e, -2.0 * e, e, 0.0],
+        )
+        .expect("returns");
+    let spread = out.s[0] - out.s[1];
+    let edge = crate::material::rounded_prism::edge_strength(cu, 0.05);
+    assert!((spread - edge).abs() < 1e-9 * cu, "{spread} vs {edge}");
+    for (scene, set, says) in [
+        (
+            "ball",
+            "material.edge_rounding=0.0",
+            "must be > 0 and <= 0.1 (got 0)",
+        ),
+        ("ball", "material.edge_rounding=0.2", "(got 0.2)"),
+        (
+            "footing",
+            "material.edge_rounding=0.05",
+            "applies only with analysis",
+        ),
+        ("cantilever", "material.edge_rounding=0.05", "\"tresca\""),
+    ] {
+        let err = load(scene, set).expect_err(set).to_string();
+        assert!(
+            err.contains("material.edge_rounding") && err.contains(says),
+            "{scene} {set}: {err}"
+        );
+    }
+}

@@ -686,6 +686,7 @@ fn check_material(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invali
                 );
             }
             cu_profile(s, m, mat)?;
+            edge_rounding(s, m, mat)?;
             if m.model == MaterialModel::TrescaSoftening {
                 softening(m, mat)?;
             }
@@ -737,12 +738,35 @@ fn check_material(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invali
     }
 }
 
+/// Tresca's `edge_rounding`: in its range, and only where the criterion has edges to round.
+fn edge_rounding(s: &Scene, m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
+    let Some(rho) = m.edge_rounding else {
+        return Ok(());
+    };
+    if !s.analysis.has_hoop() {
+        return fail(
+            mat.join("edge_rounding"),
+            "applies only with analysis = \"axisymmetric\" (plane strain judges Tresca by the \
+             largest in-plane shear, which has no edges to round)"
+                .to_string(),
+        );
+    }
+    let max = crate::material::rounded_prism::MAX_ROUNDING;
+    if !(rho > 0.0 && rho <= max) {
+        return fail(
+            mat.join("edge_rounding"),
+            format!("must be > 0 and <= {max} (got {rho})"),
+        );
+    }
+    Ok(())
+}
+
 /// The keys of other models than `m`'s, each rejected by name: a table holds exactly its
 /// model's parameters.
 fn foreign_keys(m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
     use MaterialModel::*;
     const SOFT: &[MaterialModel] = &[TrescaSoftening];
-    let given: [(&str, bool, &[MaterialModel]); 14] = [
+    let given: [(&str, bool, &[MaterialModel]); 15] = [
         (
             "cu",
             m.cu != 0.0,
@@ -763,6 +787,7 @@ fn foreign_keys(m: &Material, mat: &FieldPath) -> Result<(), Invalid> {
             m.young_over_cu.is_some(),
             &[Tresca, TrescaSoftening],
         ),
+        ("edge_rounding", m.edge_rounding.is_some(), &[Tresca]),
         ("remoulded_ratio", m.remoulded_ratio.is_some(), SOFT),
         ("xi95", m.xi95.is_some(), SOFT),
         (

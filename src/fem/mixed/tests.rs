@@ -421,7 +421,7 @@ fn axisymmetric_tresca_yields_on_the_hoop_stress_too() {
     .expect("valid");
     for st in &out.states {
         let tau = max_shear_3d(&st.stress);
-        let edge = 0.5 * crate::material::rounded_prism::edge_strength(CU);
+        let edge = 0.5 * crate::material::rounded_prism::edge_strength(CU, mat.edge_rounding);
         assert!(
             (tau - edge).abs() <= 1e-9 * CU,
             "{tau} vs {edge}: {:?}",
