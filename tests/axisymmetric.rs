@@ -135,7 +135,10 @@ fn tresca_cylinder_flows_at_the_edge_strength_with_the_hoop_in_the_criterion_to_
     // 2 cu less 0.25 %) at every particle, and the platen carries it over the current section.
     let dir = workdir("axi-tresca-cylinder");
     let cu = 1.0e4;
-    let strength = pfem_mpi::material::rounded_prism::edge_strength(cu);
+    let strength = pfem_mpi::material::rounded_prism::edge_strength(
+        cu,
+        pfem_mpi::material::rounded_prism::DEFAULT_ROUNDING,
+    );
     let scene = cylinder(
         &format!("model = \"tresca\"\nyoung = 3.0e6\npoisson = 0.49\ncu = {cu}"),
         -0.2,
