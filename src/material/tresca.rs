@@ -148,9 +148,8 @@ impl Tresca {
     /// The same material judged in full principal stresses: (σ1 − σ3)/2 = cu with σzz among
     /// them, the prism's edges rounded by `edge_rounding` · cu ([`super::rounded_prism`]: at
     /// the default 1 %, 0.25 % weaker on an edge, Tresca's to 2.5e-5 cu on a face away from
-    /// them). Axisymmetry needs
-    /// it: there σzz is the hoop stress, which can be the largest or the smallest, and plastic
-    /// flow strains the hoop. In plane strain the in-plane criterion stays the default, since
+    /// them). Axisymmetry needs it: there σzz is the hoop stress, which can be the largest or
+    /// the smallest, and plastic flow strains the hoop. In plane strain the in-plane criterion stays the default, since
     /// it holds the textbook collapse loads exactly from the first plastic step.
     pub fn in_principal_stresses(self) -> Self {
         Self {
@@ -166,6 +165,7 @@ impl Tresca {
             return Err(MaterialError::InvalidParameter {
                 name: "edge_rounding",
                 value: rounding,
+                // MAX_ROUNDING, spelled out: the requirement is a static string.
                 requirement: "0 < edge_rounding <= 0.1",
             });
         }
