@@ -39,12 +39,13 @@ const RESOLVED: f64 = 1.0;
 pub(super) fn sharp_corners(bodies: &[Shape]) -> Vec<(u32, Corner)> {
     let mut out = Vec::new();
     for (b, shape) in bodies.iter().enumerate() {
-        for corner in shape.corners() {
+        for corner in shape.corners().into_iter().filter(|c| c.turn() >= MIN_TURN) {
+            let middle = corner.middle();
             let hidden = bodies
                 .iter()
                 .enumerate()
-                .any(|(o, other)| o != b && other.closest(corner.middle()).distance < 0.0);
-            if corner.turn() >= MIN_TURN && !hidden {
+                .any(|(o, other)| o != b && other.closest(middle).distance < 0.0);
+            if !hidden {
                 out.push((b as u32, corner));
             }
         }
@@ -59,12 +60,12 @@ pub(super) fn nearest_candidate(
     corner: &Corner,
     candidates: impl Iterator<Item = (usize, [f64; 2], f64, u64)>,
 ) -> Option<(f64, u64, usize)> {
+    let c = corner.middle();
     let mut best: Option<(f64, u64, usize)> = None;
     for (i, x, h, key) in candidates {
         if corner.radius >= RESOLVED * h {
             continue;
         }
-        let c = corner.middle();
         let d = (x[0] - c[0]).hypot(x[1] - c[1]);
         if d >= SNAP * h {
             continue;
